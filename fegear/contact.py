@@ -215,7 +215,7 @@ def solve_contact(
             neg = z <= 0.0
             alpha = float(np.min(Fi[neg] / (Fi[neg] - z[neg])))
             Fi_new = Fi + alpha * (z - Fi)
-            # Cells that reach zero leave the active set (and those with z <= 0 that already were 0).
+            # Cells that reach zero leave the active set.
             leaving = neg & (Fi_new <= 1e-15 * max(T, 1.0) * np.max(1.0 / h[idx]))
             leaving |= neg & (Fi_new <= 0.0)
             if not np.any(leaving):  # round-off: drop the cell that limited the step
