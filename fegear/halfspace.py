@@ -49,9 +49,7 @@ def rectangle_integral(
     return _f(X2, Y2) - _f(X1, Y2) - _f(X2, Y1) + _f(X1, Y1)
 
 
-def halfspace_influence(
-    centers: np.ndarray, half_widths: np.ndarray, E_star: float
-) -> np.ndarray:
+def halfspace_influence(centers: np.ndarray, half_widths: np.ndarray, E_star: float) -> np.ndarray:
     """Influence matrix of rectangular cells on two elastic half-spaces.
 
     Parameters

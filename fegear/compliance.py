@@ -1,0 +1,277 @@
+"""Finite-element compliance on a contact grid of cells with piecewise-constant pressure.
+
+A contact cell ``j`` carries a force ``F_j`` spread uniformly over its area, in a direction ``e_j``
+into the body. Its consistent load on the FE degrees of freedom is, with the P2 shape functions
+``N_i`` and a cell quadrature ``(x_q, w_q)`` (weights summing to one),
+
+.. math::
+
+    P_{(3i+k)\\,j} = \\sum_q w_q\\, N_i(x_q)\\, e_{jk} ,
+
+so that ``f = P F``. The approach of cell ``i`` (the cell-averaged displacement along ``e_i``) is
+``w = P^T u``, and with ``K u = f`` the body's influence matrix is
+
+.. math::
+
+    C = P^T K^{-1} P = P_c^T \\,(K^{-1})_{cc}\\, P_c ,
+
+where ``c`` are the DOFs ``P`` touches (the candidate DOFs). ``(K^{-1})_{cc}`` is the inverse of the
+Schur complement of ``K`` onto ``c`` (one sparse factorisation; :mod:`fegear.linalg`). ``C`` is
+symmetric positive definite because averaging and spreading use the same ``P`` (Galerkin form).
+
+This is not nodal force divided by area: with quadratic elements a uniform pressure puts no force
+on a triangle's corner nodes, so pressures are always the cell forces divided by cell areas.
+
+The dense block ``(K^{-1})_{cc}`` depends only on the mesh, material, clamped DOFs and ``c``;
+it is cached on disk under a content hash of those (:mod:`fegear.mesh.cache`), so a second run, or
+another grid on the same candidate region, costs only the sparse products.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+import skfem
+from scipy.spatial import cKDTree
+
+from fegear.errors import InputError
+from fegear.fem.elasticity import ElasticBody
+from fegear.linalg import inverse_block, resolve_backend
+from fegear.mesh.cache import cached_file
+
+__all__ = [
+    "SurfacePoints",
+    "CandidateOperator",
+    "locate_on_boundary",
+    "load_operator",
+    "candidate_operator",
+    "body_compliance",
+]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SurfacePoints:
+    """Points located on boundary facets of a tet mesh.
+
+    Attributes
+    ----------
+    tets
+        (n,) index of the tetrahedron owning the facet that holds each point.
+    local
+        (n, 3) reference coordinates of the point in that tetrahedron.
+    distance
+        (n,) mm, distance from the query point to the faceted surface.
+    """
+
+    tets: np.ndarray
+    local: np.ndarray
+    distance: np.ndarray
+
+
+@dataclass(frozen=True)
+class CandidateOperator:
+    """``(K^{-1})_{cc}`` of a body on its candidate DOFs.
+
+    Attributes
+    ----------
+    dofs
+        (m,) candidate DOFs in the full vector numbering.
+    G
+        (m, m) mm/N, dense symmetric block of the inverse stiffness.
+    seconds
+        Wall time to obtain it (factorisation, or reading the cache).
+    cache_hit
+        Whether it was read from the on-disk cache.
+    backend
+        The sparse direct backend used ("pardiso", "superlu"), or "cache".
+    """
+
+    dofs: np.ndarray
+    G: np.ndarray
+    seconds: float
+    cache_hit: bool
+    backend: str
+
+
+def locate_on_boundary(
+    mesh: skfem.MeshTet, boundary: str, points: np.ndarray, k: int = 12
+) -> SurfacePoints:
+    """Find, for each point, the boundary facet it lies on and its reference coordinates.
+
+    The point is projected orthogonally on the planes of the ``k`` facets with the nearest
+    centroids; the facet whose barycentric coordinates are all non-negative (or, for a point
+    slightly off a curved surface, the least negative) and which is nearest wins. The projected
+    point is expressed in the reference coordinates of the facet's tetrahedron.
+
+    Parameters
+    ----------
+    mesh
+        Tet mesh with named boundaries.
+    boundary
+        Name of the boundary holding the points.
+    points
+        (n, 3) mm.
+    """
+    if boundary not in (mesh.boundaries or {}):
+        raise InputError("boundary", boundary, f"one of {sorted(mesh.boundaries or {})}")
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    fac = mesh.boundaries[boundary]
+    tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3 nodes, 3 xyz)
+    tree = cKDTree(tri.mean(axis=1))
+    kk = min(k, fac.size)
+    _, cand = tree.query(pts, k=kk)
+    cand = cand.reshape(pts.shape[0], kk)
+    a = tri[cand, 0]
+    e1 = tri[cand, 1] - a
+    e2 = tri[cand, 2] - a
+    r = pts[:, None, :] - a
+    # Least-squares barycentric coordinates (= orthogonal projection on the facet plane).
+    g11 = np.einsum("...i,...i", e1, e1)
+    g12 = np.einsum("...i,...i", e1, e2)
+    g22 = np.einsum("...i,...i", e2, e2)
+    b1 = np.einsum("...i,...i", r, e1)
+    b2 = np.einsum("...i,...i", r, e2)
+    det = g11 * g22 - g12 * g12
+    s = (g22 * b1 - g12 * b2) / det
+    t = (g11 * b2 - g12 * b1) / det
+    bary_min = np.minimum(np.minimum(s, t), 1.0 - s - t)
+    proj = a + s[..., None] * e1 + t[..., None] * e2
+    dist = np.linalg.norm(pts[:, None, :] - proj, axis=-1)
+    inside = bary_min >= -1e-9
+    # Prefer facets containing the projection, nearest first; otherwise the least outside.
+    score = np.where(inside, dist, 1e30 - bary_min)
+    best = np.argmin(score, axis=1)
+    rows = np.arange(pts.shape[0])
+    sb = np.clip(s[rows, best], 0.0, 1.0)
+    tb = np.clip(t[rows, best], 0.0, 1.0 - sb)
+    f_best = cand[rows, best]
+    x = a[rows, best] + sb[:, None] * e1[rows, best] + tb[:, None] * e2[rows, best]
+    tets = mesh.f2t[0, fac[f_best]]
+    # Reference coordinates in the tetrahedron: x = p0 + J xi (scikit-fem's affine mapping).
+    tv = mesh.p[:, mesh.t[:, tets]].transpose(2, 1, 0)  # (n, 4, 3)
+    J = np.stack([tv[:, 1] - tv[:, 0], tv[:, 2] - tv[:, 0], tv[:, 3] - tv[:, 0]], axis=-1)
+    xi = np.linalg.solve(J, (x - tv[:, 0])[..., None])[..., 0]
+    return SurfacePoints(tets=tets, local=xi, distance=np.linalg.norm(pts - x, axis=1))
+
+
+def load_operator(
+    body: ElasticBody,
+    boundary: str,
+    points: np.ndarray,
+    weights: np.ndarray,
+    directions: np.ndarray,
+) -> sp.csr_matrix:
+    """The consistent-load matrix ``P`` (n_dofs × n_cells) of unit cell forces.
+
+    Parameters
+    ----------
+    body
+        The assembled body.
+    boundary
+        Name of the boundary the cells lie on.
+    points
+        (n_cells, q, 3) mm, quadrature points of each cell on (or within round-off of) the surface.
+    weights
+        (n_cells, q), quadrature weights of each cell, summing to one per cell.
+    directions
+        (n_cells, 3), unit direction of the cell force on this body (into the body).
+    """
+    pts = np.asarray(points, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    e = np.asarray(directions, dtype=float)
+    if (
+        pts.ndim != 3
+        or pts.shape[2] != 3
+        or w.shape != pts.shape[:2]
+        or e.shape
+        != (
+            pts.shape[0],
+            3,
+        )
+    ):
+        raise InputError(
+            "points/weights/directions",
+            f"{pts.shape}/{w.shape}/{e.shape}",
+            "(n, q, 3) / (n, q) / (n, 3)",
+        )
+    n, q = w.shape
+    loc = locate_on_boundary(body.mesh, boundary, pts.reshape(-1, 3))
+    elem = skfem.ElementTetP2()
+    sdofs = body.scalar_basis.element_dofs[:, loc.tets]  # (10, n*q)
+    phi = np.stack([elem.lbasis(loc.local.T, i)[0] for i in range(10)])  # (10, n*q)
+    cell = np.repeat(np.arange(n), q)
+    wq = w.reshape(-1)
+    rows, cols, vals = [], [], []
+    for k in range(3):
+        rows.append(3 * sdofs + k)
+        cols.append(np.broadcast_to(cell, sdofs.shape))
+        vals.append(phi * (wq * e[cell, k])[None, :])
+    P = sp.coo_matrix(
+        (
+            np.concatenate([v.ravel() for v in vals]),
+            (np.concatenate([r.ravel() for r in rows]), np.concatenate([c.ravel() for c in cols])),
+        ),
+        shape=(body.n_dofs, n),
+    ).tocsr()
+    P.eliminate_zeros()
+    return P
+
+
+def candidate_operator(
+    body: ElasticBody, dofs: np.ndarray, backend: str = "auto", cache_key: dict | None = None
+) -> CandidateOperator:
+    """``(K^{-1})_{cc}`` on the candidate DOFs ``dofs`` (full numbering; clamped ones dropped).
+
+    With ``cache_key`` (a mapping describing the mesh, material and boundary conditions), the
+    block is read from / written to the on-disk cache; the candidate DOFs are part of the key.
+    """
+    c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
+    pos = np.searchsorted(body.free, c)
+    t0 = time.perf_counter()
+    used = resolve_backend(backend)
+
+    def compute() -> np.ndarray:
+        return inverse_block(body.K, pos, backend=used)
+
+    if cache_key is None:
+        G = compute()
+        hit = False
+    else:
+        params = {
+            "kind": "inverse_block_v1",
+            "body": cache_key,
+            "dofs": c,
+            "E": body.E,
+            "nu": body.nu,
+            "n_free": int(body.free.size),
+        }
+
+        def build(path: Path) -> None:
+            with open(path, "wb") as fh:
+                np.save(fh, compute())
+
+        path, hit = cached_file("compliance", params, ".npy", build)
+        G = np.load(path)
+    dt = time.perf_counter() - t0
+    log.info("candidate operator: %d DOFs in %.2f s (%s)", c.size, dt, "cache" if hit else used)
+    return CandidateOperator(
+        dofs=c, G=G, seconds=dt, cache_hit=hit, backend="cache" if hit else used
+    )
+
+
+def body_compliance(op: CandidateOperator, P: sp.csr_matrix) -> np.ndarray:
+    """``C = P_c^T G P_c`` (n_cells × n_cells, mm/N), symmetrised.
+
+    ``P`` may have non-zero rows outside the candidate DOFs only on clamped DOFs, which do not move
+    (:func:`candidate_operator` is given the non-zero rows of ``P`` and keeps the free ones).
+    """
+    Pd = P[op.dofs, :].toarray()
+    C = Pd.T @ (op.G @ Pd)
+    return 0.5 * (C + C.T)

@@ -1,0 +1,133 @@
+"""Linear elasticity of one body with scikit-fem: quadratic tetrahedra on a linear tet mesh.
+
+The body is a :class:`skfem.MeshTet` of linear tetrahedra (gmsh order 1, so the named boundary
+facets survive the import) with the quadratic vector element ``ElementVector(ElementTetP2())``:
+the mid-edge nodes sit on the straight edges. The stiffness is the standard bilinear form of
+isotropic linear elasticity (scikit-fem ``models.elasticity.linear_elasticity``)
+
+.. math::
+
+    a(u, v) = \\int_\\Omega 2\\mu\\,\\varepsilon(u):\\varepsilon(v) + \\lambda\\,
+        \\operatorname{div} u \\operatorname{div} v \\; dx,
+    \\qquad \\lambda = \\frac{E\\nu}{(1+\\nu)(1-2\\nu)},\\; \\mu = \\frac{E}{2(1+\\nu)} .
+
+Degrees of freedom are numbered ``3 * scalar_dof + component`` (scikit-fem's interleaved vector
+numbering, checked in the tests). Dirichlet conditions are given as sets of clamped DOFs; the
+reduced matrix on the free DOFs is what the compliance needs.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import skfem
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from fegear.errors import InputError
+
+__all__ = ["ElasticBody", "assemble_body", "boundary_dofs"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ElasticBody:
+    """An assembled elastic body with its clamped DOFs removed.
+
+    Attributes
+    ----------
+    mesh
+        The linear tetrahedral mesh (mm) with named boundaries.
+    basis
+        ``skfem.Basis`` of ``ElementVector(ElementTetP2())`` on ``mesh``.
+    scalar_basis
+        ``skfem.Basis`` of ``ElementTetP2()`` (the scalar DOF numbering).
+    K
+        (n_free, n_free) CSR stiffness (N/mm) on the free DOFs.
+    free
+        (n_free,) indices of the free DOFs in the full numbering.
+    E, nu
+        Young's modulus (MPa) and Poisson's ratio.
+    assembly_seconds
+        Wall time of the assembly.
+    """
+
+    mesh: skfem.MeshTet
+    basis: skfem.Basis
+    scalar_basis: skfem.Basis
+    K: sp.csr_matrix
+    free: np.ndarray
+    E: float
+    nu: float
+    assembly_seconds: float
+
+    @property
+    def n_dofs(self) -> int:
+        """Number of DOFs before the Dirichlet conditions."""
+        return int(self.basis.N)
+
+
+def boundary_dofs(basis: skfem.Basis, boundary: str, components: str = "xyz") -> np.ndarray:
+    """Vector DOFs (full numbering) of the nodes on a named boundary, for the given components."""
+    mesh = basis.mesh
+    if boundary not in (mesh.boundaries or {}):
+        raise InputError("boundary", boundary, f"one of {sorted(mesh.boundaries or {})}")
+    facets = mesh.boundaries[boundary]
+    dofs = basis.get_dofs(facets)
+    out = []
+    for c in components:
+        key = "u^" + str("xyz".index(c) + 1)
+        out.append(dofs.nodal[key])
+        if key in dofs.facet:
+            out.append(dofs.facet[key])
+        if key in dofs.edge:
+            out.append(dofs.edge[key])
+    return np.unique(np.concatenate(out))
+
+
+def assemble_body(
+    mesh: skfem.MeshTet, E: float, nu: float, clamped: list[tuple[str, str]]
+) -> ElasticBody:
+    """Assemble the stiffness of a body and remove its clamped DOFs.
+
+    Parameters
+    ----------
+    mesh
+        Linear tet mesh in mm with named boundaries.
+    E, nu
+        Young's modulus (MPa, > 0) and Poisson's ratio (in (-1, 0.5)).
+    clamped
+        ``[(boundary name, components)]``, e.g. ``[("bottom", "xyz"), ("sym_x", "x")]``.
+    """
+    if not (np.isfinite(E) and E > 0):
+        raise InputError("E_MPa", E, "> 0")
+    if not (np.isfinite(nu) and -1.0 < nu < 0.5):
+        raise InputError("nu", nu, "in (-1, 0.5)")
+    t0 = time.perf_counter()
+    basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTetP2()))
+    scalar = skfem.Basis(mesh, skfem.ElementTetP2(), quadrature=basis.quadrature)
+    lam, mu = lame_parameters(E, nu)
+    K = skfem.asm(linear_elasticity(lam, mu), basis).tocsr()
+    fixed = np.unique(
+        np.concatenate([boundary_dofs(basis, name, comps) for name, comps in clamped])
+        if clamped
+        else np.zeros(0, dtype=np.int64)
+    )
+    free = np.setdiff1d(np.arange(basis.N), fixed)
+    Kf = K[free][:, free].tocsr()
+    dt = time.perf_counter() - t0
+    log.info("assembled %d DOFs (%d free) in %.2f s", basis.N, free.size, dt)
+    return ElasticBody(
+        mesh=mesh,
+        basis=basis,
+        scalar_basis=scalar,
+        K=Kf,
+        free=free,
+        E=float(E),
+        nu=float(nu),
+        assembly_seconds=dt,
+    )

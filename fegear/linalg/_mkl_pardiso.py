@@ -1,0 +1,305 @@
+"""Minimal ctypes binding to Intel oneMKL PARDISO, for dense Schur complements.
+
+Only what :func:`fegear.linalg.schur.schur_complement` needs: locate and load ``mkl_rt`` (the same
+search as pypardiso), run PARDISO phase 12 (analysis + numerical factorization) in Schur mode on the
+upper triangle of a real symmetric positive definite matrix, and always release the solver memory
+(phase -1).
+
+PARDISO settings (oneMKL developer reference, "pardiso iparm Parameter"):
+
+- ``mtype = 2`` (real symmetric positive definite): Cholesky ``L Lᵀ`` without pivoting, so no pivot
+  perturbation can alter the Schur complement. A non-SPD input fails with error -4 (zero or negative
+  pivot), which we report. The symmetric indefinite type ``-2`` is not needed: Schur mode works with
+  ``mtype = 2`` (checked against dense and SuperLU references in ``tests/test_schur.py``).
+- ``iparm`` starts from ``pardisoinit`` defaults for that ``mtype`` (``iparm[1] = 3``: the
+  OpenMP-parallel METIS nested dissection ordering; ``iparm[7] = 2`` refinement steps, unused as
+  there is no solve phase), then:
+
+  - ``iparm[34] = 1``: zero-based ``ia``/``ja`` (no index shift copy needed from SciPy CSR);
+  - ``iparm[35] = 1``: Schur mode, "compute the Schur complement only". The Schur block is
+    the set of rows ``i`` with ``perm[i] = 1`` (``perm`` is then *not* a fill-reducing
+    permutation; the rest of it is 0). PARDISO eliminates all other unknowns and returns the dense
+    ``m × m`` Schur matrix in the solution array ``x``, row-major, rows and columns in *increasing
+    original index order* whatever order the caller has in mind (both triangles filled, observed
+    with MKL 2026.2). ``iparm[35] = 2`` would also keep the factors for later solves (phases
+    331–333), which we do not need;
+  - ``iparm[26] = 0``: no matrix checker (we build sorted, zero-based CSR ourselves).
+
+- Threads: ``MKL_Set_Num_Threads_Local`` around the call (restored afterwards); ``MKL_NUM_THREADS``
+  is honoured when set.
+- The LP64 interface (32-bit ``MKL_INT``) is requested with ``MKL_Set_Interface_Layer``; a process
+  whose ``mkl_rt`` is already locked to ILP64 is reported as "PARDISO not available".
+"""
+
+from __future__ import annotations
+
+import ctypes
+import glob
+import logging
+import os
+import site
+import sys
+import threading
+import time
+from ctypes.util import find_library
+
+import numpy as np
+import scipy.sparse as sp
+
+from fegear.errors import BackendUnavailable, SolverError
+
+__all__ = ["PARDISO_ERRORS", "MklPardiso", "load_library"]
+
+logger = logging.getLogger(__name__)
+
+#: Meaning of PARDISO's ``error`` output (oneMKL developer reference, "pardiso").
+PARDISO_ERRORS: dict[int, str] = {
+    -1: "input inconsistent",
+    -2: "not enough memory",
+    -3: "reordering problem",
+    -4: "zero or negative pivot: the matrix is singular or not positive definite "
+    "(are all rigid-body modes constrained?)",
+    -5: "unclassified (internal) error",
+    -6: "reordering failed",
+    -7: "diagonal matrix is singular",
+    -8: "32-bit integer overflow problem",
+    -9: "not enough memory for out-of-core",
+    -10: "error opening out-of-core files",
+    -11: "read/write error with out-of-core files",
+    -12: "pardiso_64 called from a 32-bit library",
+    -13: "interrupted by the mkl_progress function",
+    -15: "internal error (two-level factorization with matching)",
+}
+
+_MKL_INTERFACE_LP64 = 0
+_MTYPE_SPD = 2
+_PHASE_ANALYSIS_FACTOR = 12
+_PHASE_RELEASE_ALL = -1
+_INT32_MAX = np.iinfo(np.int32).max
+
+
+def _candidate_paths() -> list[str]:
+    """Where to look for ``mkl_rt``, in the order pypardiso uses (explicit env var first)."""
+    paths: list[str] = []
+    for var in ("FEGEAR_MKL_RT", "PYPARDISO_MKL_RT"):
+        if os.environ.get(var):
+            paths.append(os.environ[var])
+    for name in ("mkl_rt", "mkl_rt.1", "mkl_rt.2"):
+        found = find_library(name)
+        if found:
+            paths.append(found)
+    # The `mkl` wheel puts the library directly in <prefix>/lib (Linux, macOS x86_64) or
+    # <prefix>/Library/bin (Windows); try those before pypardiso's recursive glob.
+    for prefix in (sys.prefix, site.USER_BASE or ""):
+        if not prefix:
+            continue
+        for pattern in ("lib/libmkl_rt.*", "Library/bin/mkl_rt*.dll"):
+            paths.extend(sorted(glob.glob(os.path.join(prefix, pattern)), key=len))
+    for prefix in (sys.prefix, site.USER_BASE or ""):
+        if prefix:
+            paths.extend(
+                sorted(glob.glob(f"{prefix}/[Ll]ib*/**/*mkl_rt*", recursive=True), key=len)
+            )
+    # Drop duplicates, keep order.
+    return list(dict.fromkeys(paths))
+
+
+class MklPardiso:
+    """A loaded ``mkl_rt`` with the PARDISO entry points typed for ctypes.
+
+    Parameters
+    ----------
+    lib
+        The loaded shared library.
+    path
+        Where it was loaded from (for log messages).
+    """
+
+    def __init__(self, lib: ctypes.CDLL, path: str) -> None:
+        self.lib = lib
+        self.path = path
+        self._pardiso = lib.pardiso
+        self._pardiso.restype = None
+        p_int = ctypes.POINTER(ctypes.c_int32)
+        self._pardiso.argtypes = [
+            ctypes.c_void_p,  # pt (64 pointer-sized handles)
+            p_int,  # maxfct
+            p_int,  # mnum
+            p_int,  # mtype
+            p_int,  # phase
+            p_int,  # n
+            ctypes.c_void_p,  # a
+            ctypes.c_void_p,  # ia
+            ctypes.c_void_p,  # ja
+            ctypes.c_void_p,  # perm
+            p_int,  # nrhs
+            ctypes.c_void_p,  # iparm
+            p_int,  # msglvl
+            ctypes.c_void_p,  # b
+            ctypes.c_void_p,  # x
+            p_int,  # error
+        ]
+        self._pardisoinit = lib.pardisoinit
+        self._pardisoinit.restype = None
+        self._pardisoinit.argtypes = [ctypes.c_void_p, p_int, ctypes.c_void_p]
+        self._set_threads_local = lib.MKL_Set_Num_Threads_Local
+        self._set_threads_local.restype = ctypes.c_int
+        self._set_threads_local.argtypes = [ctypes.c_int]
+        self._lock = threading.Lock()
+
+    def version(self) -> str:
+        """The MKL version string, e.g. ``"Intel(R) oneAPI Math Kernel Library Version 2026.2"``."""
+        buf = ctypes.create_string_buffer(256)
+        self.lib.MKL_Get_Version_String(buf, ctypes.c_int(len(buf)))
+        return buf.value.decode(errors="replace").strip()
+
+    def _call(
+        self,
+        pt: np.ndarray,
+        phase: int,
+        n: int,
+        data: np.ndarray,
+        indptr: np.ndarray,
+        indices: np.ndarray,
+        perm: np.ndarray,
+        iparm: np.ndarray,
+        x: np.ndarray,
+    ) -> int:
+        b = np.zeros(max(n, 1))  # never read in phases 12 / -1
+        error = ctypes.c_int32(0)
+        self._pardiso(
+            pt.ctypes.data,
+            ctypes.byref(ctypes.c_int32(1)),  # maxfct
+            ctypes.byref(ctypes.c_int32(1)),  # mnum
+            ctypes.byref(ctypes.c_int32(_MTYPE_SPD)),
+            ctypes.byref(ctypes.c_int32(phase)),
+            ctypes.byref(ctypes.c_int32(n)),
+            data.ctypes.data,
+            indptr.ctypes.data,
+            indices.ctypes.data,
+            perm.ctypes.data,
+            ctypes.byref(ctypes.c_int32(1)),  # nrhs
+            iparm.ctypes.data,
+            ctypes.byref(ctypes.c_int32(0)),  # msglvl: silent
+            b.ctypes.data,
+            x.ctypes.data,
+            ctypes.byref(error),
+        )
+        return int(error.value)
+
+    def schur_spd(
+        self, upper: sp.csr_matrix, schur_rows: np.ndarray, n_threads: int | None
+    ) -> np.ndarray:
+        """Dense Schur complement of an SPD matrix onto the rows flagged in ``schur_rows``.
+
+        Parameters
+        ----------
+        upper
+            Upper triangle (diagonal included) of the SPD matrix ``K``, CSR, shape ``(n, n)``,
+            float64, sorted column indices.
+        schur_rows
+            Sorted, unique row indices ``c`` of the Schur block, shape ``(m,)``, ``0 < m < n``.
+        n_threads
+            MKL threads for this call; ``None`` keeps MKL's setting (``MKL_NUM_THREADS``).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``S = K_cc − K_ci K_ii⁻¹ K_ic``, shape ``(m, m)``, rows and columns in the order of
+            ``schur_rows`` (increasing index), exactly as PARDISO returns it (not symmetrised).
+
+        Raises
+        ------
+        SolverError
+            PARDISO reported an error (message gives the code and its meaning).
+        """
+        n = upper.shape[0]
+        m = schur_rows.size
+        if upper.nnz > _INT32_MAX or n > _INT32_MAX:
+            raise SolverError(
+                f"PARDISO (LP64): matrix too large for 32-bit indices (n={n}, nnz={upper.nnz})"
+            )
+        data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        indptr = np.ascontiguousarray(upper.indptr, dtype=np.int32)
+        indices = np.ascontiguousarray(upper.indices, dtype=np.int32)
+        perm = np.zeros(n, dtype=np.int32)
+        perm[schur_rows] = 1
+        pt = np.zeros(64, dtype=np.int64)  # opaque handle, 64 pointer-sized slots
+        iparm = np.zeros(64, dtype=np.int32)
+        self._pardisoinit(
+            pt.ctypes.data, ctypes.byref(ctypes.c_int32(_MTYPE_SPD)), iparm.ctypes.data
+        )
+        iparm[26] = 0  # matrix checker off: CSR built here, sorted and zero-based
+        iparm[34] = 1  # zero-based ia / ja
+        iparm[35] = 1  # Schur mode: compute the dense Schur complement only, returned in x
+        x = np.zeros(m * m, dtype=np.float64)
+
+        with self._lock:  # one PARDISO call at a time: the thread setting is per calling thread
+            previous = self._set_threads_local(int(n_threads)) if n_threads else None
+            try:
+                t0 = time.perf_counter()
+                err = self._call(
+                    pt, _PHASE_ANALYSIS_FACTOR, n, data, indptr, indices, perm, iparm, x
+                )
+                elapsed = time.perf_counter() - t0
+            finally:
+                rel = self._call(
+                    pt, _PHASE_RELEASE_ALL, n, data, indptr, indices, perm, iparm, np.zeros(1)
+                )
+                if previous is not None:
+                    self._set_threads_local(previous)
+        if err != 0:
+            meaning = PARDISO_ERRORS.get(err, "unknown error code")
+            detail = ""
+            if err == -4 and iparm[29] > 0:
+                detail = f"; first bad pivot at equation {int(iparm[29])}"
+            raise SolverError(
+                f"PARDISO phase 12 (Schur mode) failed: error {err}, {meaning}{detail}"
+            )
+        if rel != 0:
+            logger.warning("PARDISO memory release (phase -1) returned error %d", rel)
+        logger.debug("PARDISO Schur: n=%d m=%d in %.2f s, nnz(L)=%d", n, m, elapsed, int(iparm[17]))
+        return x.reshape(m, m)
+
+
+def load_library() -> MklPardiso:
+    """Locate and load ``mkl_rt`` and type its PARDISO entry points.
+
+    The search follows pypardiso: ``FEGEAR_MKL_RT`` / ``PYPARDISO_MKL_RT`` (explicit path),
+    ``ctypes.util.find_library``, then ``<sys.prefix>/lib`` (and ``Library/bin`` on Windows) and a
+    recursive search under ``sys.prefix`` and the user site.
+
+    Returns
+    -------
+    MklPardiso
+        The loaded library.
+
+    Raises
+    ------
+    BackendUnavailable
+        No loadable ``mkl_rt`` with PARDISO, or it is locked to the ILP64 interface.
+    """
+    errors: list[str] = []
+    for path in _candidate_paths():
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError as exc:
+            errors.append(f"{path}: {exc}")
+            continue
+        try:
+            lib.pardiso  # noqa: B018 - attribute lookup is the existence check
+            lib.pardisoinit  # noqa: B018
+            lib.MKL_Set_Num_Threads_Local  # noqa: B018
+        except AttributeError as exc:
+            errors.append(f"{path}: {exc}")
+            continue
+        layer = lib.MKL_Set_Interface_Layer(ctypes.c_int(_MKL_INTERFACE_LP64))
+        if layer != _MKL_INTERFACE_LP64:
+            raise BackendUnavailable(
+                f"{path} is locked to the ILP64 interface (layer {layer}); need LP64"
+            )
+        return MklPardiso(lib, path)
+    reason = "mkl_rt shared library not found (pip install mkl, or set FEGEAR_MKL_RT)"
+    if errors:
+        reason += "; tried: " + "; ".join(errors)
+    raise BackendUnavailable(reason)

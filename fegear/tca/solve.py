@@ -1,0 +1,178 @@
+"""Newton solves on the exact flanks: circle hits (angular gaps) and normal-line hits (separations).
+
+Angular gap (Litvin & Fuentes 2004 §9.4 TCA, written as a distance problem). Member 2 turns
+about its axis; a point ``Q`` (gear-tooth frame, cylindrical ``(ρ, φ, z)`` about the gear axis) is
+reached by the gear flank after a rotation ``θ`` iff the flank meets the circle ``(ρ_Q, z_Q)``:
+
+.. math::  \\rho(r_2(a, b)) = \\rho_Q, \\quad z(r_2(a, b)) = z_Q, \\qquad
+           \\theta = s_2 \\,(\\varphi(r_2) - \\varphi_Q),
+
+two equations in the two flank parameters (2×2 Newton), then ``θ`` in closed form. ``θ`` is the
+rotation of member 2 *against* its driving sense (a lag) that brings the gear flank onto ``Q``;
+the smallest ``θ`` over the pinion flank is the rotation that closes the gap (the tangency
+conditions of TCA are its stationarity conditions).
+
+Separation along the pinion normal: ``r_2(a, b) = P + s n_1`` (3×3 Newton in ``a, b, s``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..geometry.transforms import apply_points, apply_vectors
+from .surfaces import FlankMap
+
+Array = NDArray[np.float64]
+#: Newton stops at this residual (mm); the solves converge quadratically to ~1e-12 mm
+TOL_MM = 1e-10
+
+
+def _map(T: Array | None, p: Array, vec: bool = False) -> Array:
+    if T is None:
+        return p
+    return apply_vectors(T, p) if vec else apply_points(T, p)
+
+
+def circle_hit(
+    fm: FlankMap,
+    T: Array | None,
+    a: Array,
+    b: Array,
+    rho_t: Array,
+    z_t: Array,
+    max_iter: int = 25,
+) -> tuple[Array, Array, Array, Array, Array]:
+    """Parameters where ``T · r(a, b)`` meets the circles ``(ρ_t, z_t)`` about ``z``.
+
+    Parameters
+    ----------
+    fm
+        Flank evaluator (member frame).
+    T
+        ``(..., 4, 4)`` member frame → target frame, or None (identity).
+    a, b
+        ``(...)`` initial native parameters.
+    rho_t, z_t
+        ``(...)`` target circle radius and height (mm).
+
+    Returns
+    -------
+    a, b : (...)
+        Native parameters of the hit.
+    p, n : (..., 3)
+        Point and unit normal in the target frame.
+    ok : (...) bool
+        Converged (residual < ``TOL_MM``).
+    """
+    shape = np.broadcast_shapes(np.shape(a), np.shape(rho_t), np.shape(z_t))
+    a = np.broadcast_to(np.asarray(a, dtype=float), shape).ravel().copy()
+    b = np.broadcast_to(np.asarray(b, dtype=float), shape).ravel().copy()
+    rho_t = np.broadcast_to(np.asarray(rho_t, dtype=float), shape).ravel()
+    z_t = np.broadcast_to(np.asarray(z_t, dtype=float), shape).ravel()
+    Tf = None
+    if T is not None:
+        Tf = np.broadcast_to(T, shape + (4, 4)).reshape(-1, 4, 4)
+    lo, hi = fm.native_box()
+    span = hi - lo
+    lo, hi = lo - 0.5 * span, hi + 0.5 * span
+    act = np.arange(a.size)
+    prev = np.full(a.size, np.inf)
+    for it in range(max_iter):
+        if act.size == 0:
+            break
+        aa, bb = a[act], b[act]
+        Ta = None if Tf is None else Tf[act]
+        p0, _ = fm.evaluate(aa, bb)
+        ra, rb = fm.jacobian(aa, bb, p0)
+        p = _map(Ta, p0)
+        ra, rb = _map(Ta, ra, True), _map(Ta, rb, True)
+        rho = np.hypot(p[..., 0], p[..., 1])
+        F1, F2 = rho - rho_t[act], p[..., 2] - z_t[act]
+        r = np.hypot(F1, F2)
+        done = ~(r >= TOL_MM)  # converged (or NaN: give up)
+        if it >= 6:  # no intersection (the circle misses the flank): Newton stalls; give up
+            done |= r > 0.5 * prev[act]
+        prev[act] = r
+        er = p[..., :2] / np.maximum(rho, 1e-300)[..., None]
+        j11 = np.sum(er * ra[..., :2], -1)
+        j12 = np.sum(er * rb[..., :2], -1)
+        j21, j22 = ra[..., 2], rb[..., 2]
+        det = j11 * j22 - j12 * j21
+        det = np.where(np.abs(det) > 1e-300, det, 1e-300)
+        da = np.nan_to_num(-(j22 * F1 - j12 * F2) / det)
+        db = np.nan_to_num(-(j11 * F2 - j21 * F1) / det)
+        # trust region: at most a quarter of the working box per step
+        sc = np.maximum(
+            1.0, np.maximum(np.abs(da) / (0.25 * span[0]), np.abs(db) / (0.25 * span[1]))
+        )
+        a[act] = np.where(done, aa, np.clip(aa + da / sc, lo[0], hi[0]))
+        b[act] = np.where(done, bb, np.clip(bb + db / sc, lo[1], hi[1]))
+        act = act[~done]
+    p0, n0 = fm.evaluate(a, b)
+    p, n = _map(Tf, p0), _map(Tf, n0, True)
+    res = np.hypot(np.hypot(p[..., 0], p[..., 1]) - rho_t, p[..., 2] - z_t)
+    ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
+    return (
+        a.reshape(shape),
+        b.reshape(shape),
+        p.reshape(shape + (3,)),
+        n.reshape(shape + (3,)),
+        ok.reshape(shape),
+    )
+
+
+def line_hit(
+    fm: FlankMap, a: Array, b: Array, P: Array, N: Array, max_iter: int = 25
+) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """Intersection of the lines ``P + s N`` with the flank ``r(a, b)`` (member frame).
+
+    Returns ``a, b, s, p, n, ok``; ``s`` (mm) is the separation along ``N``.
+    """
+    a = np.array(a, dtype=float)
+    b = np.array(b, dtype=float)
+    s = np.zeros(a.shape)
+    lo, hi = fm.native_box()
+    span = hi - lo
+    lo, hi = lo - 0.5 * span, hi + 0.5 * span
+    for _ in range(max_iter):
+        p, _ = fm.evaluate(a, b)
+        ra, rb = fm.jacobian(a, b, p)
+        F = p - P - s[..., None] * N
+        if np.all(np.linalg.norm(F, axis=-1) < TOL_MM):
+            break
+        J = np.stack([ra, rb, -N], -1)
+        # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
+        dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[..., None])[..., 0]
+        dx = np.nan_to_num(dx)
+        sc = np.maximum(
+            1.0,
+            np.maximum(
+                np.abs(dx[..., 0]) / (0.25 * span[0]), np.abs(dx[..., 1]) / (0.25 * span[1])
+            ),
+        )
+        a = np.clip(a + dx[..., 0] / sc, lo[0], hi[0])
+        b = np.clip(b + dx[..., 1] / sc, lo[1], hi[1])
+        s = s + dx[..., 2] / sc
+    p, n = fm.evaluate(a, b)
+    res = np.linalg.norm(p - P - s[..., None] * N, axis=-1)
+    ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
+    return a, b, s, p, n, ok
+
+
+def in_bounds(fm: FlankMap, u: Array, v: Array, tol: float = 1e-9) -> Array:
+    """Flank coordinates inside the working flank (relative tolerance ``tol`` of the spans)."""
+    bd = fm.bounds
+    tu = tol * (bd.u_tip - bd.u_fillet)
+    tv = tol * (bd.v_end - bd.v_start)
+    return (
+        (u >= bd.u_fillet - tu)
+        & (u <= bd.u_tip + tu)
+        & (v >= bd.v_start - tv)
+        & (v <= bd.v_end + tv)
+    )
+
+
+def wrap(x: Array) -> Array:
+    """Angle wrapped into (−π, π]."""
+    return np.pi - np.mod(np.pi - x, 2 * np.pi)
