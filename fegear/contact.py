@@ -138,8 +138,13 @@ def _subproblem(
     rhs = np.column_stack([h[idx], -g[idx]])
     sol = scipy.linalg.cho_solve(cf, rhs, check_finite=False)
     x, y = sol[:, 0], sol[:, 1]
-    theta = (load - h[idx] @ y) / (h[idx] @ x)
-    return theta * x + y, float(theta)
+    hx = h[idx] @ x
+    theta = (load - h[idx] @ y) / hx
+    z = theta * x + y
+    # theta x + y cancels when |y| >> |z| (gap offsets >> C T, ill-conditioned C_II): one
+    # refinement step along x restores h^T z = T and leaves d_I = g_I - theta h_I + C_II z unchanged
+    delta = (load - h[idx] @ z) / hx
+    return z + delta * x, float(theta + delta)
 
 
 def _objective(C: np.ndarray, g: np.ndarray, F: np.ndarray) -> float:
@@ -213,14 +218,18 @@ def solve_contact(
             # Largest step alpha in [0, 1) from F towards z with F + alpha (z - F) >= 0.
             Fi = F[idx]
             neg = z <= 0.0
-            alpha = float(np.min(Fi[neg] / (Fi[neg] - z[neg])))
+            # ratio test; a cell with F = 0 (just added) and z <= 0 blocks at once (alpha = 0),
+            # without the 0/0 of F = z = 0
+            ratio = np.full(idx.size, np.inf)
+            blocking = neg & (Fi - z > 0.0)
+            ratio[blocking] = Fi[blocking] / (Fi[blocking] - z[blocking])
+            ratio[neg & ~blocking] = 0.0  # F = z = 0: a just-added cell that gets no force
+            alpha = float(np.min(ratio))
             Fi_new = Fi + alpha * (z - Fi)
             # Cells that reach zero leave the active set.
             leaving = neg & (Fi_new <= 1e-15 * max(T, 1.0) * np.max(1.0 / h[idx]))
             leaving |= neg & (Fi_new <= 0.0)
             if not np.any(leaving):  # round-off: drop the cell that limited the step
-                ratio = np.full(idx.size, np.inf)
-                ratio[neg] = Fi[neg] / (Fi[neg] - z[neg])
                 leaving[int(np.argmin(ratio))] = True
             Fi_new[leaving] = 0.0
             Fi_new = np.maximum(Fi_new, 0.0)

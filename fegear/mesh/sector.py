@@ -70,9 +70,9 @@ log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
 #: fine (contact-zone) element size per level, in modules
-FINE = (0.6, 0.42, 0.3, 0.21, 0.15)
+FINE = (0.45, 0.32, 0.22, 0.16, 0.11)
 #: coarse (far-field) element size per level, in modules
-COARSE = (2.0, 1.6, 1.25, 1.0, 0.8)
+COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
 _VERSION = "sector-1"
 
 
@@ -433,7 +433,7 @@ def sector_mesh(
     zone: Sequence[FlankZone] | None = None,
     rim_modules: float = 3.0,
     algorithm: int = 10,
-    min_sicn: float = 0.1,
+    min_sicn: float = 0.05,
 ) -> SectorMesh:
     """Mesh (or load from the cache) a sector of ``n_teeth`` teeth of ``member``.
 

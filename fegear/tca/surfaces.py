@@ -71,7 +71,13 @@ class FlankMap:
         return np.asarray(a, float), np.asarray(b, float)
 
     def native_box(self) -> tuple[Array, Array]:
-        """Lower/upper native bounds of the working flank (used to clamp Newton steps)."""
+        """Lower/upper native bounds of the working flank (used to clamp Newton steps; cached)."""
+        box = self._cache.get("box")
+        if box is None:
+            box = self._cache["box"] = self._native_box()
+        return box
+
+    def _native_box(self) -> tuple[Array, Array]:
         bd = self.bounds
         a0, b0 = self.native(np.array([bd.u_fillet, bd.u_tip]), np.array([bd.v_start, bd.v_end]))
         lo = np.array([min(a0), min(b0)])
@@ -177,7 +183,7 @@ class FaceGearMap(FlankMap):
         env, t, _ = self.member._solve(self.side, u, v)
         return np.asarray(t, float), np.asarray(env.psi, float)
 
-    def native_box(self):
+    def _native_box(self):
         bd = self.bounds
         U, V = np.meshgrid([bd.u_fillet, bd.u_tip], [bd.v_start, bd.v_end])
         a, b = self.native(U, V)

@@ -1,0 +1,145 @@
+"""Tooth-sector meshes (DESIGN §6): named groups, flank accuracy, volume, static convergence.
+
+Meshes are cached (``meshes/cache`` or ``$FEGEAR_CACHE``); a cold run meshes the coarsest levels
+only. The spiral bevel pair is designed once per session (~12 s).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from fegear.errors import InputError
+from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.mesh.sector import FlankZone, SectorMesh, mesh_sizes, sector_mesh
+from fegear.mesh.sector_check import tooth_compliance
+from fegear.mesh.sector_geometry import flank_distance, section_integral_volume, sector_frame
+
+log = logging.getLogger(__name__)
+
+
+def fzg_pinion() -> InvoluteMember:
+    return InvoluteMember(
+        InvoluteDesign(16, 4.5, 20.0, profile_shift=0.1817, face_width_mm=14.0), "pinion"
+    )
+
+
+def face_gear_pinion() -> InvoluteMember:
+    # FaceGearMember.pinion() keeps the 0.38 rack tip radius, which the validation refuses for
+    # α = 25° with h_f* = 1.25 (tip arcs overlap); 0.3 is the largest round value allowed.
+    d = FaceGearDesign()
+    return InvoluteMember(
+        InvoluteDesign(
+            d.n_pinion, d.module_mm, d.pressure_angle_deg, rack_tip_radius_coeff=0.3,
+            face_width_mm=d.pinion_face_width_mm,
+        ),
+        "pinion",
+    )  # fmt: skip
+
+
+@pytest.fixture(scope="session")
+def bevel_pair():
+    from fegear.geometry.spiral_bevel import SpiralBevelPair
+
+    return SpiralBevelPair.design()
+
+
+MEMBERS = ["fzg_pinion", "face_gear", "face_gear_pinion", "bevel_pinion", "bevel_gear"]
+
+
+@pytest.fixture(scope="session", params=MEMBERS)
+def member(request, bevel_pair):
+    name = request.param
+    if name == "fzg_pinion":
+        return fzg_pinion()
+    if name == "face_gear":
+        return FaceGearMember(FaceGearDesign())
+    if name == "face_gear_pinion":
+        return face_gear_pinion()
+    return bevel_pair.pinion if name == "bevel_pinion" else bevel_pair.gear
+
+
+@pytest.fixture(scope="session")
+def sector(member) -> SectorMesh:
+    return sector_mesh(member, n_teeth=3, level=0)
+
+
+def test_named_groups(sector: SectorMesh):
+    fixed = "base" if sector.family == "face_gear" else "bore"
+    expected = {"cut_left", "cut_right", fixed, "face_start", "face_end"}
+    for j in range(3):
+        expected |= {f"flank_drive_{j}", f"flank_coast_{j}", f"fillet_{j}", f"top_{j}"}
+    assert set(sector.boundaries) == expected
+    assert all(len(t) > 0 for t in sector.boundaries.values())
+    m = sector.to_skfem()
+    assert m.t.shape[1] == len(sector.tets)
+    # every named triangle is a boundary facet of the tet mesh (exact: same node indices)
+    for name, tri in sector.boundaries.items():
+        assert len(m.boundaries[name]) == len(tri), name
+    # quality gate held (the mesher raises below it)
+    assert sector.diagnostics["min_sicn"] >= 0.05
+
+
+def _local_size(mesh: SectorMesh, name: str) -> tuple[np.ndarray, np.ndarray]:
+    tri = mesh.boundaries[name]
+    p = mesh.points
+    e = np.linalg.norm(p[tri] - p[np.roll(tri, 1, axis=1)], axis=-1)  # (k, 3) edge lengths
+    nodes = np.unique(tri)
+    acc = np.zeros(len(p))
+    cnt = np.zeros(len(p))
+    for c in range(3):
+        np.add.at(acc, tri[:, c], e.mean(axis=1))
+        np.add.at(cnt, tri[:, c], 1)
+    return nodes, acc[nodes] / cnt[nodes]
+
+
+def test_flank_nodes_on_analytic_surface(member, sector: SectorMesh):
+    fr = sector_frame(member)
+    j = sector.centre_tooth
+    worst = 0.0
+    for side in ("drive", "coast"):
+        nodes, h = _local_size(sector, f"flank_{side}_{j}")
+        d, _ = flank_distance(fr, side, 0, sector.points[nodes])
+        worst = max(worst, float(np.max(d / h)))
+        # tolerance: 1 % of the local element size (issue requirement); the CAD flank is a
+        # spline loft through exact sections and gmsh puts boundary nodes on the CAD surface
+        assert np.all(d < 0.01 * h), f"{side}: max distance / local size = {np.max(d / h):.2e}"
+    log.info("%s: max flank-node distance / local size = %.2e", member.name, worst)
+
+
+def test_volume_against_section_integral(member, sector: SectorMesh):
+    fr = sector_frame(member)
+    ref = section_integral_volume(fr, 3)
+    err = sector.volume() / ref - 1
+    # tolerance: linear tets chord curved faces (error O(h²/R): the bore gains volume, convex
+    # faces lose it; ~0.5 % at level 0); face gear / bevel add the difference between the CAD
+    # root blend (cubic) and the chord the estimate uses (< 0.5 %): 1.5 % in all.
+    assert abs(err) < 0.015, f"mesh volume {sector.volume():.1f} vs {ref:.1f}: {err:+.3%}"
+    log.info("%s: volume error %+.3f %%", member.name, 100 * err)
+
+
+def test_spur_static_convergence():
+    """Deflection under a unit normal load at the pitch point, levels 0-1-2, bore+cuts fixed."""
+    m = fzg_pinion()
+    fr = sector_frame(m)
+    d = np.array([tooth_compliance(sector_mesh(m, level=lv), fr) for lv in (0, 1, 2)])
+    h = np.array([mesh_sizes(fr.module, lv)[0] for lv in (0, 1, 2)])
+    e01, e12 = abs(d[1] - d[0]), abs(d[2] - d[1])
+    rate = np.log(e01 / e12) / np.log(h[0] / h[1])
+    msg = f"deflections {d} mm/N, observed rate {rate:.2f}"
+    print(msg)
+    # tolerance: the change from level 1 to 2 is below 3 % of the deflection (coarse levels;
+    # the benchmark goes finer), and it shrinks (rate > 0.5: unstructured, non-nested meshes
+    # with linear geometry give a noisy rate near 2)
+    assert e12 < 0.03 * d[2], msg
+    assert rate > 0.5, msg
+
+
+def test_zone_and_inputs():
+    m = fzg_pinion()
+    with pytest.raises(InputError):
+        sector_mesh(m, level=7)
+    with pytest.raises(InputError):
+        sector_mesh(m, zone=[FlankZone(5, "drive", (3.0, 6.0), (-2.0, 2.0))])

@@ -1,0 +1,245 @@
+"""Schur complement / inverse block backends (fegear.linalg).
+
+A small scikit-fem P2 elasticity box (clamped at z = 0), candidate DOFs on the top face. PARDISO
+parts are skipped where MKL is absent (macOS arm64), so the suite runs everywhere.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+import scipy.linalg as la
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import skfem
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from fegear.errors import BackendUnavailable, InputError, SolverError
+from fegear.linalg import (
+    ENV_SOLVER,
+    _mkl_pardiso,
+    available_backends,
+    inverse_block,
+    resolve_backend,
+    schur,
+    schur_complement,
+)
+
+# Every comparison of two direct solvers on the same SPD matrix: both are backward stable, the
+# box's condition number is ~1e5, so they agree to ~1e-12; 1e-10 leaves margin, catches any bug.
+TOL_SOLVERS = 1e-10
+
+
+def _rel(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.linalg.norm(a - b) / np.linalg.norm(b))
+
+
+@pytest.fixture(scope="module")
+def box() -> tuple[sp.csr_matrix, np.ndarray]:
+    """Clamped P2 steel box (3×3×4 cells, ~2.5k free DOFs) and its top-face DOFs (shuffled)."""
+    mesh = skfem.MeshTet.init_tensor(
+        np.linspace(0.0, 1.0, 4), np.linspace(0.0, 1.0, 4), np.linspace(0.0, 1.5, 5)
+    )
+    basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTetP2()))
+    K = linear_elasticity(*lame_parameters(206000.0, 0.3)).assemble(basis)
+    clamped = basis.get_dofs(lambda x: np.isclose(x[2], 0.0)).all()
+    top = basis.get_dofs(lambda x: np.isclose(x[2], 1.5)).all()
+    free = np.setdiff1d(np.arange(basis.N), clamped)
+    idx = np.searchsorted(free, top)
+    idx = np.random.default_rng(1).permutation(idx)  # not sorted: order handling is exercised
+    return K[free][:, free].tocsr(), idx
+
+
+@pytest.fixture(scope="module")
+def reference(box: tuple[sp.csr_matrix, np.ndarray]) -> np.ndarray:
+    """(K⁻¹)[idx][:, idx] from plain SuperLU back-solves on the whole K, unit vectors e_j."""
+    K, idx = box
+    lu = spla.splu(K.tocsc())
+    E = np.zeros((K.shape[0], idx.size))
+    E[idx, np.arange(idx.size)] = 1.0
+    return lu.solve(E)[idx]
+
+
+@pytest.fixture
+def fresh_probe():
+    """Forget the cached PARDISO probe before and after a test that patches the loader."""
+    schur._clear_backend_cache()
+    yield
+    schur._clear_backend_cache()
+
+
+@pytest.fixture
+def no_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(ENV_SOLVER, raising=False)
+
+
+def _needs_pardiso() -> None:
+    if "pardiso" not in available_backends():
+        pytest.skip("MKL PARDISO not available on this machine")
+
+
+def test_superlu_inverse_block_matches_back_solves(box, reference) -> None:
+    K, idx = box
+    C = inverse_block(K, idx, "superlu")
+    assert C.shape == (idx.size, idx.size)
+    assert _rel(C, reference) < TOL_SOLVERS
+
+
+def test_pardiso_schur_matches_superlu(box) -> None:
+    _needs_pardiso()
+    K, idx = box
+    S_p = schur_complement(K, idx, "pardiso")
+    S_s = schur_complement(K, idx, "superlu")
+    assert _rel(S_p, S_s) < TOL_SOLVERS
+
+
+def test_pardiso_inverse_block_matches_back_solves(box, reference) -> None:
+    _needs_pardiso()
+    K, idx = box
+    assert _rel(inverse_block(K, idx, "pardiso"), reference) < TOL_SOLVERS
+
+
+def test_schur_matches_dense_formula(box) -> None:
+    """S = K_cc − K_ci K_ii⁻¹ K_ic, dense, on a 60-DOF subset (independent of both backends)."""
+    K, idx = box
+    c = idx[:60]
+    i = np.setdiff1d(np.arange(K.shape[0]), c)
+    Kd = K.toarray()
+    S_ref = Kd[np.ix_(c, c)] - Kd[np.ix_(c, i)] @ la.solve(
+        Kd[np.ix_(i, i)], Kd[np.ix_(i, c)], assume_a="pos"
+    )
+    for backend in available_backends():
+        assert _rel(schur_complement(K, c, backend), S_ref) < TOL_SOLVERS, backend
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_blocks_symmetric_positive_definite(box, backend) -> None:
+    if backend == "pardiso":
+        _needs_pardiso()
+    K, idx = box
+    for block in (schur_complement(K, idx, backend), inverse_block(K, idx, backend)):
+        # Both blocks are symmetrised on return: exact symmetry, not just to round-off.
+        np.testing.assert_array_equal(block, block.T)
+        la.cholesky(block)  # raises LinAlgError unless positive definite
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_idx_order_respected(box, backend) -> None:
+    if backend == "pardiso":
+        _needs_pardiso()
+    K, idx = box
+    p = np.random.default_rng(7).permutation(idx.size)
+    S = schur_complement(K, idx, backend)
+    S_perm = schur_complement(K, idx[p], backend)
+    # Same factorization up to the elimination order: round-off only.
+    assert _rel(S_perm, S[np.ix_(p, p)]) < TOL_SOLVERS
+    C_sorted = inverse_block(K, np.sort(idx), backend)
+    rank = np.argsort(np.argsort(idx))  # position of idx[a] in sorted order
+    assert _rel(inverse_block(K, idx, backend), C_sorted[np.ix_(rank, rank)]) < TOL_SOLVERS
+
+
+def test_all_dofs_candidates_gives_K() -> None:
+    K = sp.diags([-np.ones(4), 3.0 * np.ones(5), -np.ones(4)], [-1, 0, 1], format="csr")
+    idx = np.array([4, 0, 2, 1, 3])
+    for backend in available_backends():
+        # No interior DOFs: S is K itself, copied exactly.
+        np.testing.assert_array_equal(
+            schur_complement(K, idx, backend), K.toarray()[np.ix_(idx, idx)]
+        )
+
+
+def test_loader_failure_falls_back_to_superlu(
+    monkeypatch, caplog, fresh_probe, no_env, box
+) -> None:
+    def broken_loader() -> _mkl_pardiso.MklPardiso:
+        raise BackendUnavailable("mkl_rt shared library not found (test)")
+
+    monkeypatch.setattr(_mkl_pardiso, "load_library", broken_loader)
+    with caplog.at_level(logging.INFO, logger="fegear.linalg.schur"):
+        assert resolve_backend("auto") == "superlu"
+    assert "PARDISO not available (mkl_rt shared library not found (test))" in caplog.text
+    assert "using SciPy SuperLU" in caplog.text
+    assert available_backends() == ("superlu",)
+    with pytest.raises(BackendUnavailable, match="PARDISO"):
+        resolve_backend("pardiso")
+    K, idx = box
+    with pytest.raises(BackendUnavailable):
+        schur_complement(K, idx[:10], "pardiso")
+    assert schur_complement(K, idx[:10]).shape == (10, 10)  # auto still works, via SuperLU
+
+
+def test_auto_picks_pardiso_when_available(caplog, no_env) -> None:
+    _needs_pardiso()
+    with caplog.at_level(logging.INFO, logger="fegear.linalg.schur"):
+        assert resolve_backend("auto") == "pardiso"
+    assert "MKL PARDISO" in caplog.text
+
+
+def test_env_var_honoured(monkeypatch, fresh_probe) -> None:
+    monkeypatch.setenv(ENV_SOLVER, "superlu")
+    assert resolve_backend() == "superlu"
+    assert resolve_backend("auto") == "superlu"
+    monkeypatch.setenv(ENV_SOLVER, "SuperLU ")  # case and whitespace do not matter
+    assert resolve_backend() == "superlu"
+    monkeypatch.setenv(ENV_SOLVER, "cholmod")
+    with pytest.raises(InputError, match=ENV_SOLVER):
+        resolve_backend()
+    monkeypatch.setenv(ENV_SOLVER, "pardiso")
+    if "pardiso" in available_backends():
+        assert resolve_backend() == "pardiso"
+    monkeypatch.setattr(_mkl_pardiso, "load_library", _raise_unavailable)
+    schur._clear_backend_cache()
+    with pytest.raises(BackendUnavailable):  # asked for by the environment: explicit
+        resolve_backend()
+    assert resolve_backend("superlu") == "superlu"  # an explicit argument beats the environment
+
+
+def _raise_unavailable() -> _mkl_pardiso.MklPardiso:
+    raise BackendUnavailable("patched out")
+
+
+def test_input_checks(box) -> None:
+    K, idx = box
+    n = K.shape[0]
+    with pytest.raises(InputError, match="scipy.sparse"):
+        schur_complement(K.toarray(), idx)
+    with pytest.raises(InputError, match="K.shape"):
+        schur_complement(K[:, :-1], idx[idx < n - 1])
+    with pytest.raises(InputError, match="unique"):
+        schur_complement(K, np.array([3, 5, 3]))
+    with pytest.raises(InputError, match="idx"):
+        schur_complement(K, np.array([0, n]))
+    with pytest.raises(InputError, match="idx"):
+        schur_complement(K, np.array([-1, 2]))
+    with pytest.raises(InputError, match="idx"):
+        schur_complement(K, np.array([0.0, 1.0]))
+    with pytest.raises(InputError, match="backend"):
+        schur_complement(K, idx, "mumps")
+    asym = K.tolil()
+    asym[0, 1] += 1.0  # max|K| ~ 1e5: an asymmetry of 1 is far above round-off
+    with pytest.raises(InputError, match="symmetric"):
+        schur_complement(asym.tocsr(), idx)
+    assert schur_complement(K, np.array([], dtype=int)).shape == (0, 0)
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_indefinite_matrix_raises_solver_error(backend) -> None:
+    if backend == "pardiso":
+        _needs_pardiso()
+    # Tridiagonal (-1, 1, -1), n = 30: eigenvalues 1 - 2 cos(k pi / 31), ten of them negative;
+    # its interior block (n = 28) has nine, so by Haynsworth's inertia additivity S has one.
+    n = 30
+    K = sp.diags([-np.ones(n - 1), np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    with pytest.raises(SolverError):
+        inverse_block(K, np.array([0, n - 1]), backend)
+
+
+def test_nonpositive_diagonal_rejected() -> None:
+    # A DOF with no stiffness at all (unconstrained, no element): zero diagonal, explicit.
+    K = sp.diags([-np.ones(4), 2.0 * np.ones(5), -np.ones(4)], [-1, 0, 1]).tolil()
+    K[4, 4], K[3, 4], K[4, 3] = 0.0, 0.0, 0.0
+    for backend in available_backends():
+        with pytest.raises(InputError, match="diagonal"):
+            schur_complement(K.tocsr(), np.array([0, 1]), backend)
