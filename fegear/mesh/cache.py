@@ -88,6 +88,9 @@ def cached_file(
     fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=suffix, dir=folder)
     os.close(fd)
     tmp_path = Path(tmp)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp_path, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual mode
     try:
         build(tmp_path)
         os.replace(tmp_path, path)

@@ -433,7 +433,7 @@ def sector_mesh(
     zone: Sequence[FlankZone] | None = None,
     rim_modules: float = 3.0,
     algorithm: int = 10,
-    min_sicn: float = 0.05,
+    min_sicn: float = 0.03,
 ) -> SectorMesh:
     """Mesh (or load from the cache) a sector of ``n_teeth`` teeth of ``member``.
 

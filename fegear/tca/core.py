@@ -75,7 +75,7 @@ class TCAOptions:
     search_grid: tuple[int, int] = (15, 9)
     separation_grid: tuple[int, int] | None = (15, 9)
     edge_samples: int = 25
-    refine_iter: int = 14
+    refine_iter: int = 30
     paint_mm: float = 0.00632
     pinion_torque_Nm: float | None = None
     E_MPa: float = 206000.0
@@ -254,47 +254,47 @@ class TCA:
         lo = np.array([bd.u_fillet, bd.v_start])
         hi = np.array([bd.u_tip, bd.v_end])
         h = np.broadcast_to(self.step1, x.shape).copy()
+        hmin = 1e-10 * (hi - lo)
         o = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], float)  # (9, 2)
+        act = np.arange(len(x))
         for _ in range(self.opt.refine_iter):
-            pts = np.clip(x[:, None, :] + o[None] * h[:, None, :], lo, hi)  # (C, 9, 2)
-            fs = self._theta_pinion(T, pts[..., 0], pts[..., 1])[0]
-            # quadratic model in normalised offsets
-            s = (pts - x[:, None, :]) / h[:, None, :]
-            D = np.stack(
-                [
-                    np.ones_like(s[..., 0]),
-                    s[..., 0],
-                    s[..., 1],
-                    s[..., 0] ** 2,
-                    s[..., 0] * s[..., 1],
-                    s[..., 1] ** 2,
-                ],
-                -1,
-            )
+            act = act[np.any(h[act] > hmin, -1)]
+            if act.size == 0:
+                break
+            xa, fa, ha, Ta = x[act], f[act], h[act], T[act]
+            pts = np.clip(xa[:, None, :] + o[None] * ha[:, None, :], lo, hi)  # (c, 9, 2)
+            fs = self._theta_pinion(Ta, pts[..., 0], pts[..., 1])[0]
+            # least-squares quadratic model in normalised offsets, Newton step (<= 4 steps)
+            s = (pts - xa[:, None, :]) / ha[:, None, :]
+            D = np.stack([np.ones_like(s[..., 0]), s[..., 0], s[..., 1], s[..., 0] ** 2,
+                          s[..., 0] * s[..., 1], s[..., 1] ** 2], -1)  # fmt: skip
             fin = np.isfinite(fs)
             W = fin.astype(float)
-            fz = np.where(fin, fs - np.where(np.isfinite(f), f, 0.0)[:, None], 0.0)
+            fz = np.where(fin, fs - np.where(np.isfinite(fa), fa, 0.0)[:, None], 0.0)
             A = np.einsum("cki,ck,ckj->cij", D, W, D) + 1e-12 * np.eye(6)
             rhs = np.einsum("cki,ck,ck->ci", D, W, fz)
             c = np.linalg.solve(A, rhs[..., None])[..., 0]
             g = c[:, 1:3]
-            H = np.stack(
-                [np.stack([2 * c[:, 3], c[:, 4]], -1), np.stack([c[:, 4], 2 * c[:, 5]], -1)], -2
-            )
+            H = np.stack([np.stack([2 * c[:, 3], c[:, 4]], -1),
+                          np.stack([c[:, 4], 2 * c[:, 5]], -1)], -2)  # fmt: skip
             ev = np.linalg.eigvalsh(H)
-            H = H + np.maximum(0.0, 1e-8 - ev[:, :1])[:, :, None] * np.eye(2)
-            step = -np.linalg.solve(H, g[..., None])[..., 0]
-            step = np.clip(np.nan_to_num(step), -2.0, 2.0)
+            H = H + np.maximum(0.0, 1e-3 * np.abs(ev[:, 1:]) - ev[:, :1])[:, :, None] * np.eye(2)
+            step = -np.linalg.solve(H + 1e-300 * np.eye(2), g[..., None])[..., 0]
+            step = np.nan_to_num(step)
+            step = step / np.maximum(1.0, np.abs(step).max(-1, keepdims=True) / 4.0)
             good = fin.sum(-1) >= 6
-            xn = np.clip(x + np.where(good[:, None], step, 0.0) * h, lo, hi)
-            fn = self._theta_pinion(T, xn[:, None, 0], xn[:, None, 1])[0][:, 0]
+            xn = np.clip(xa + np.where(good[:, None], step, 0.0) * ha, lo, hi)
+            fn = self._theta_pinion(Ta, xn[:, None, 0], xn[:, None, 1])[0][:, 0]
             cand = np.concatenate([fs, fn[:, None]], -1)
             cx = np.concatenate([pts, xn[:, None]], 1)
             k = np.argmin(cand, -1)
-            better = cand[np.arange(len(k)), k] < f
-            x = np.where(better[:, None], cx[np.arange(len(k)), k], x)
-            f = np.where(better, cand[np.arange(len(k)), k], f)
-            h = h * 0.3
+            r = np.arange(len(k))
+            better = cand[r, k] < fa
+            xb = np.where(better[:, None], cx[r, k], xa)
+            moved = np.abs((xb - xa) / ha).max(-1)
+            # keep the stencil while the minimum is travelling, shrink it once it is bracketed
+            ha = ha * np.where(moved >= 0.99, 1.0, np.maximum(0.3 * moved, 0.05))[:, None]
+            x[act], f[act], h[act] = xb, np.where(better, cand[r, k], fa), ha
         return x, f
 
     def _centre_line_contact(self, T: Array, x: Array, f: Array, tol: float = 1e-12) -> Array:
