@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -47,23 +48,38 @@ class ElasticBody:
     scalar_basis
         ``skfem.Basis`` of ``ElementTetP2()`` (the scalar DOF numbering).
     K
-        (n_free, n_free) CSR stiffness (N/mm) on the free DOFs.
+        (n_free, n_free) CSR stiffness (N/mm) on the free DOFs, assembled on first use (a run
+        whose compliance operator is cached never needs it).
     free
         (n_free,) indices of the free DOFs in the full numbering.
     E, nu
         Young's modulus (MPa) and Poisson's ratio.
-    assembly_seconds
-        Wall time of the assembly.
     """
 
     mesh: skfem.MeshTet
     basis: skfem.Basis
     scalar_basis: skfem.Basis
-    K: sp.csr_matrix
     free: np.ndarray
     E: float
     nu: float
-    assembly_seconds: float
+    _timing: dict[str, float] = field(default_factory=dict, repr=False, compare=False)
+
+    @cached_property
+    def K(self) -> sp.csr_matrix:  # noqa: N802 (the stiffness matrix is K)
+        """Stiffness on the free DOFs (N/mm), assembled once."""
+        t0 = time.perf_counter()
+        lam, mu = lame_parameters(self.E, self.nu)
+        K = skfem.asm(linear_elasticity(lam, mu), self.basis).tocsr()
+        Kf = K[self.free][:, self.free].tocsr()
+        self._timing["assembly"] = time.perf_counter() - t0
+        log.info("assembled %d DOFs (%d free) in %.2f s", self.basis.N, self.free.size,
+                 self._timing["assembly"])
+        return Kf
+
+    @property
+    def assembly_seconds(self) -> float:
+        """Wall time of the stiffness assembly (0 if it was never needed)."""
+        return self._timing.get("assembly", 0.0)
 
     @property
     def n_dofs(self) -> int:
@@ -92,7 +108,7 @@ def boundary_dofs(basis: skfem.Basis, boundary: str, components: str = "xyz") ->
 def assemble_body(
     mesh: skfem.MeshTet, E: float, nu: float, clamped: list[tuple[str, str]]
 ) -> ElasticBody:
-    """Assemble the stiffness of a body and remove its clamped DOFs.
+    """Set up a body: its P2 bases and free DOFs (the stiffness is assembled on first use).
 
     Parameters
     ----------
@@ -107,27 +123,13 @@ def assemble_body(
         raise InputError("E_MPa", E, "> 0")
     if not (np.isfinite(nu) and -1.0 < nu < 0.5):
         raise InputError("nu", nu, "in (-1, 0.5)")
-    t0 = time.perf_counter()
     basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTetP2()))
     scalar = skfem.Basis(mesh, skfem.ElementTetP2(), quadrature=basis.quadrature)
-    lam, mu = lame_parameters(E, nu)
-    K = skfem.asm(linear_elasticity(lam, mu), basis).tocsr()
     fixed = np.unique(
         np.concatenate([boundary_dofs(basis, name, comps) for name, comps in clamped])
         if clamped
         else np.zeros(0, dtype=np.int64)
     )
     free = np.setdiff1d(np.arange(basis.N), fixed)
-    Kf = K[free][:, free].tocsr()
-    dt = time.perf_counter() - t0
-    log.info("assembled %d DOFs (%d free) in %.2f s", basis.N, free.size, dt)
-    return ElasticBody(
-        mesh=mesh,
-        basis=basis,
-        scalar_basis=scalar,
-        K=Kf,
-        free=free,
-        E=float(E),
-        nu=float(nu),
-        assembly_seconds=dt,
-    )
+    return ElasticBody(mesh=mesh, basis=basis, scalar_basis=scalar, free=free, E=float(E),
+                       nu=float(nu))

@@ -42,7 +42,7 @@ __all__ = ["BodyMeshSpec", "mesh_block", "mesh_roller", "read_tet_mesh", "roller
 
 log = logging.getLogger(__name__)
 
-MESH_VERSION = "hertz_bodies_v1"
+MESH_VERSION = "hertz_bodies_v2"
 
 
 @dataclass(frozen=True)
@@ -89,7 +89,7 @@ def _init(name: str) -> None:
 
     gmsh.initialize(interruptible=False)
     gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.option.setNumber("General.NumThreads", 2)
+    gmsh.option.setNumber("General.NumThreads", 1)  # deterministic meshes (HXT is parallel)
     gmsh.model.add(name)
 
 
