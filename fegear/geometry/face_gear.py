@@ -185,6 +185,9 @@ class FaceGearMember:
                 pressure_angle_deg=d.pressure_angle_deg,
                 addendum_coeff=d.addendum_coeff,
                 dedendum_coeff=d.dedendum_coeff,
+                # 0.38 m (the 20° default) exceeds the largest rack tip radius that fits the
+                # dedendum at 25° (0.318 m); 0.25 m fits every pressure angle up to 25°.
+                rack_tip_radius_coeff=0.25,
                 face_width_mm=face_width_mm or d.pinion_face_width_mm,
             ),
             name="pinion",
