@@ -12,7 +12,7 @@ Hertz scene (``kind = "hertz_scene"``)::
     [roller]  radii_mm = [Rx, Ry] (required), half_length_mm, E_MPa, nu
     [block]   half_size_mm, height_mm, E_MPa, nu
     [mesh]    level (0..5), symmetry ("quarter" | "none"), grid_margin
-    [solver]  backend ("auto" | "pardiso" | "superlu")
+    [solver]  backend ("auto" | "pardiso" | "superlu"), fidelity ("fe" | "hybrid"), fe_level
     [study]   levels = [0, 1, 2, ...]   (optional: a mesh-convergence study)
 """
 
@@ -49,7 +49,7 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], bool]]] = {
         "nu": (_NUM, False),
     },
     "mesh": {"level": (int, False), "symmetry": (str, False), "grid_margin": (_NUM, False)},
-    "solver": {"backend": (str, False)},
+    "solver": {"backend": (str, False), "fidelity": (str, False), "fe_level": (int, False)},
     "study": {"levels": (list, False)},
 }
 _REQUIRED_SECTIONS = ("case", "load", "roller")
@@ -63,6 +63,8 @@ class HertzCase:
     scene: HertzScene
     level: int
     backend: str
+    fidelity: str
+    fe_level: int
     study_levels: tuple[int, ...]
     source: str
 
@@ -139,6 +141,12 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
     backend = sections["solver"].get("backend", "auto")
     if backend not in ("auto", "pardiso", "superlu"):
         raise InputError("solver.backend", backend, "'auto', 'pardiso' or 'superlu'")
+    fidelity = sections["solver"].get("fidelity", "fe")
+    if fidelity not in ("fe", "hybrid"):
+        raise InputError("solver.fidelity", fidelity, "'fe' or 'hybrid'")
+    fe_level = sections["solver"].get("fe_level", 0)
+    if not 0 <= fe_level < nlev:
+        raise InputError("solver.fe_level", fe_level, f"an integer in [0, {nlev - 1}]")
     levels = sections["study"].get("levels", [])
     for i, lv in enumerate(levels):
         if not (isinstance(lv, int) and not isinstance(lv, bool) and 0 <= lv < nlev):
@@ -148,6 +156,8 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
         scene=scene,
         level=int(level),
         backend=backend,
+        fidelity=fidelity,
+        fe_level=int(fe_level),
         study_levels=tuple(sorted(set(levels))),
         source=source,
     )

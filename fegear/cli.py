@@ -37,6 +37,11 @@ def _parser() -> argparse.ArgumentParser:
         choices=["auto", "pardiso", "superlu"],
         help="sparse direct solver; overrides the case",
     )
+    r.add_argument(
+        "--fidelity",
+        choices=["fe", "hybrid"],
+        help="fe: pure FE compliance; hybrid: coarse FE + half-space near field",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     return p
 
@@ -62,6 +67,8 @@ def _run(args: argparse.Namespace) -> int:
     if not 0 <= level < len(CELLS_ACROSS_MINOR):
         raise InputError("--level", level, f"an integer in [0, {len(CELLS_ACROSS_MINOR) - 1}]")
     backend = args.backend or case.backend
+    fidelity = args.fidelity or case.fidelity
+    kw = {"backend": backend, "fidelity": fidelity, "fe_level": case.fe_level}
     study_levels = case.study_levels
     if args.study:
         try:
@@ -70,12 +77,15 @@ def _run(args: argparse.Namespace) -> int:
             raise InputError("--study", args.study, "comma-separated integers") from exc
     out = Path(args.out)
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr))
-    say(f"fegear {__version__}: case {case.name!r} ({case.source}), level {level}, out {out}/")
+    say(
+        f"fegear {__version__}: case {case.name!r} ({case.source}), fidelity {fidelity}, "
+        f"level {level}, out {out}/"
+    )
     study = []
     for i, lv in enumerate(study_levels):
         t0 = time.perf_counter()
         say(f"[study {i + 1}/{len(study_levels)}] level {lv} ...")
-        res = run_level(case.scene, lv, backend=backend)
+        res = run_level(case.scene, lv, **kw)
         say(
             f"    p0 {res.p0_MPa:8.1f} MPa ({res.error('p0'):+.2%})  a {res.a_mm:.4f} mm "
             f"({res.error('a'):+.2%})  b {res.b_mm:.4f} mm ({res.error('b'):+.2%})  "
@@ -93,7 +103,7 @@ def _run(args: argparse.Namespace) -> int:
         say("observed rates: " + ", ".join(f"{k} {v:.2f}" for k, v in rate.items()))
     say(f"[run] level {level}: meshes, stiffness, compliance, contact, fields ...")
     t0 = time.perf_counter()
-    res = run_level(case.scene, level, backend=backend, with_fields=True)
+    res = run_level(case.scene, level, with_fields=True, **kw)
     for w in res.warnings:
         say(f"warning: {w}")
     say(

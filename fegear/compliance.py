@@ -203,11 +203,21 @@ def load_operator(
         )
     n, q = w.shape
     loc = locate_on_boundary(body.mesh, boundary, pts.reshape(-1, 3))
+    return _shape_operator(body, loc, w.reshape(-1), np.repeat(np.arange(n), q), e, n)
+
+
+def _shape_operator(
+    body: ElasticBody,
+    loc: SurfacePoints,
+    wq: np.ndarray,
+    cell: np.ndarray,
+    e: np.ndarray,
+    n: int,
+) -> sp.csr_matrix:
+    """Sparse ``Σ_q w_q N_i(x_q) e_k`` from located points (one column per cell)."""
     elem = skfem.ElementTetP2()
     sdofs = body.scalar_basis.element_dofs[:, loc.tets]  # (10, n*q)
     phi = np.stack([elem.lbasis(loc.local.T, i)[0] for i in range(10)])  # (10, n*q)
-    cell = np.repeat(np.arange(n), q)
-    wq = w.reshape(-1)
     rows, cols, vals = [], [], []
     for k in range(3):
         rows.append(3 * sdofs + k)
@@ -222,6 +232,29 @@ def load_operator(
     ).tocsr()
     P.eliminate_zeros()
     return P
+
+
+def locate_inside(mesh: skfem.MeshTet, points: np.ndarray) -> SurfacePoints:
+    """Tetrahedra and reference coordinates of interior points (``distance`` is zero)."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    try:
+        tets = mesh.element_finder()(pts[:, 0], pts[:, 1], pts[:, 2])
+    except ValueError as exc:
+        raise InputError("points", "outside the mesh", "inside the body") from exc
+    tv = mesh.p[:, mesh.t[:, tets]].transpose(2, 1, 0)
+    J = np.stack([tv[:, 1] - tv[:, 0], tv[:, 2] - tv[:, 0], tv[:, 3] - tv[:, 0]], axis=-1)
+    xi = np.linalg.solve(J, (pts - tv[:, 0])[..., None])[..., 0]
+    return SurfacePoints(tets=tets, local=xi, distance=np.zeros(pts.shape[0]))
+
+
+def probe_operator(body: ElasticBody, points: np.ndarray, directions: np.ndarray) -> sp.csr_matrix:
+    """``Q`` (n_dofs × n): column ``i`` reads the displacement at ``points[i]`` along
+    ``directions[i]`` (``w_i = Q_i^T u``); the points may be anywhere inside the body."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    e = np.asarray(directions, dtype=float).reshape(-1, 3)
+    n = pts.shape[0]
+    loc = locate_inside(body.mesh, pts)
+    return _shape_operator(body, loc, np.ones(n), np.arange(n), e, n)
 
 
 def candidate_operator(
@@ -275,3 +308,10 @@ def body_compliance(op: CandidateOperator, P: sp.csr_matrix) -> np.ndarray:
     Pd = P[op.dofs, :].toarray()
     C = Pd.T @ (op.G @ Pd)
     return 0.5 * (C + C.T)
+
+
+def cross_compliance(op: CandidateOperator, Q: sp.csr_matrix, P: sp.csr_matrix) -> np.ndarray:
+    """``Q_c^T G P_c`` (n_probe × n_cells, mm/N): probe readings per unit cell force."""
+    Qd = Q[op.dofs, :].toarray()
+    Pd = P[op.dofs, :].toarray()
+    return Qd.T @ (op.G @ Pd)

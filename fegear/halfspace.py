@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["rectangle_integral", "halfspace_influence"]
+__all__ = ["rectangle_integral", "halfspace_influence", "subsurface_influence"]
 
 
 def _f(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
@@ -77,3 +77,79 @@ def halfspace_influence(centers: np.ndarray, half_widths: np.ndarray, E_star: fl
     y2 = (c[:, 1] + hw[:, 1])[None, :]
     area = (4.0 * hw[:, 0] * hw[:, 1])[None, :]
     return rectangle_integral(x, y, x1, x2, y1, y2) / (np.pi * E_star * area)
+
+
+def _f_depth(X: np.ndarray, Y: np.ndarray, z: float) -> tuple[np.ndarray, np.ndarray]:
+    """Antiderivatives at depth ``z > 0``: of ``1/ρ`` and of ``z/ρ³``, ``ρ = sqrt(X²+Y²+z²)``.
+
+    ``∬ dX dY / ρ = X asinh(Y / sqrt(X²+z²)) + Y asinh(X / sqrt(Y²+z²)) - z atan(XY / (z ρ))``
+    (the ``X ln(Y + ρ)`` form less terms in ``X`` or ``Y`` alone, which cancel in the corner sum)
+    and ``∬ z dX dY / ρ³ = atan(XY / (z ρ))`` (the solid angle of the rectangle seen from depth
+    ``z``; Gradshteyn & Ryzhik 2.271, 2.284).
+    """
+    rho = np.sqrt(X * X + Y * Y + z * z)
+    i1 = (
+        X * np.arcsinh(Y / np.sqrt(X * X + z * z))
+        + Y * np.arcsinh(X / np.sqrt(Y * Y + z * z))
+        - z * np.arctan(X * Y / (z * rho))
+    )
+    i2 = np.arctan(X * Y / (z * rho))
+    return i1, i2
+
+
+def subsurface_influence(
+    points: np.ndarray,
+    depth: float,
+    centers: np.ndarray,
+    half_widths: np.ndarray,
+    E: float,
+    nu: float,
+) -> np.ndarray:
+    """Normal displacement of ONE half-space at depth ``z`` under uniform pressure on cells.
+
+    Boussinesq's point-force solution (Johnson 1985, eq. 3.21a): the displacement along the
+    load direction at depth ``z`` and horizontal distance ``r`` from a force ``P`` is
+
+    .. math:: u_z = \\frac{P}{4\\pi G}\\Big[\\frac{z^2}{\\rho^3}
+        + \\frac{2(1-\\nu)}{\\rho}\\Big], \\qquad \\rho^2 = r^2 + z^2,\\;
+        G = \\frac{E}{2(1+\\nu)},
+
+    integrated in closed form over each rectangle (see :func:`_f_depth`). At ``z = 0`` it reduces
+    to ``(1-ν²)/(πE) ∬ p / r`` of :func:`halfspace_influence` for one body.
+
+    Parameters
+    ----------
+    points
+        (n, 2) mm, horizontal positions of the field points.
+    depth
+        mm, depth ``z >= 0`` below the surface (``0`` uses the surface formula).
+    centers, half_widths
+        (m, 2) mm, the loaded cells.
+    E, nu
+        The body's Young's modulus (MPa) and Poisson's ratio.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, m) mm/N: displacement at point ``i`` per unit force spread on cell ``j``.
+    """
+    pts = np.asarray(points, dtype=float)
+    c = np.asarray(centers, dtype=float)
+    hw = np.asarray(half_widths, dtype=float)
+    area = (4.0 * hw[:, 0] * hw[:, 1])[None, :]
+    x = pts[:, 0][:, None]
+    y = pts[:, 1][:, None]
+    X1 = (c[:, 0] - hw[:, 0])[None, :] - x
+    X2 = (c[:, 0] + hw[:, 0])[None, :] - x
+    Y1 = (c[:, 1] - hw[:, 1])[None, :] - y
+    Y2 = (c[:, 1] + hw[:, 1])[None, :] - y
+    if depth <= 0.0:
+        E_one = E / (1.0 - nu * nu)
+        return rectangle_integral(0.0, 0.0, X1, X2, Y1, Y2) / (np.pi * E_one * area)
+    G = E / (2.0 * (1.0 + nu))
+    i1, i2 = 0.0, 0.0
+    for Xa, Ya, sgn in ((X2, Y2, 1.0), (X1, Y2, -1.0), (X2, Y1, -1.0), (X1, Y1, 1.0)):
+        a1, a2 = _f_depth(Xa, Ya, depth)
+        i1 = i1 + sgn * a1
+        i2 = i2 + sgn * a2
+    return (depth * i2 + 2.0 * (1.0 - nu) * i1) / (4.0 * np.pi * G * area)

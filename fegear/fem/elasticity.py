@@ -72,8 +72,12 @@ class ElasticBody:
         K = skfem.asm(linear_elasticity(lam, mu), self.basis).tocsr()
         Kf = K[self.free][:, self.free].tocsr()
         self._timing["assembly"] = time.perf_counter() - t0
-        log.info("assembled %d DOFs (%d free) in %.2f s", self.basis.N, self.free.size,
-                 self._timing["assembly"])
+        log.info(
+            "assembled %d DOFs (%d free) in %.2f s",
+            self.basis.N,
+            self.free.size,
+            self._timing["assembly"],
+        )
         return Kf
 
     @property
@@ -131,5 +135,6 @@ def assemble_body(
         else np.zeros(0, dtype=np.int64)
     )
     free = np.setdiff1d(np.arange(basis.N), fixed)
-    return ElasticBody(mesh=mesh, basis=basis, scalar_basis=scalar, free=free, E=float(E),
-                       nu=float(nu))
+    return ElasticBody(
+        mesh=mesh, basis=basis, scalar_basis=scalar, free=free, E=float(E), nu=float(nu)
+    )

@@ -43,6 +43,7 @@ def level_row(r: HertzLevelResult) -> dict[str, object]:
     """One row of the per-level table (JSON-ready)."""
     return {
         "level": r.level,
+        "fidelity": r.fidelity,
         "cells_across_minor": r.cells_across_minor,
         "cell_size_mm": r.cell_size_mm,
         "element_size_mm": r.h_fine_mm,
@@ -77,6 +78,7 @@ def hertz_summary(
     return {
         "case": case_name,
         "kind": "hertz_scene",
+        "fidelity": r.fidelity,
         "units": {"length": "mm", "force": "N", "pressure": "MPa"},
         "inputs": {
             "force_N": scene.force_N,
@@ -85,6 +87,7 @@ def hertz_summary(
             "E_MPa": [scene.E_roller_MPa, scene.E_block_MPa],
             "nu": [scene.nu_roller, scene.nu_block],
             "symmetry": scene.symmetry,
+            "fidelity": r.fidelity,
             "level": r.level,
         },
         "result": {

@@ -34,10 +34,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fegear.compliance import body_compliance, candidate_operator, load_operator
+from fegear.compliance import (
+    body_compliance,
+    candidate_operator,
+    cross_compliance,
+    load_operator,
+    probe_operator,
+)
 from fegear.contact import ContactSolution, solve_contact
 from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body
+from fegear.halfspace import subsurface_influence
 from fegear.hertz import HertzPoint, hertz_point_radii
 from fegear.mesh.hertz_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh, roller_height
 from fegear.patch import measure_patch
@@ -58,6 +65,8 @@ log = logging.getLogger(__name__)
 CELLS_ACROSS_MINOR = (6, 8, 12, 16, 24, 32)
 #: FE element size in the refined zone, in cell sizes.
 ELEMENT_TO_CELL = 2.0
+#: Depth of the FE matching points of the hybrid fidelity, in FE element sizes.
+HYBRID_DEPTH_ELEMENTS = 2.0
 #: Fewer cells than this across the computed minor axis triggers a warning (DESIGN §7).
 MIN_CELLS_ACROSS_MINOR = 8.0
 
@@ -152,6 +161,7 @@ class HertzLevelResult:
     pressure: np.ndarray
     force: np.ndarray
     symmetry: str
+    fidelity: str
     modelled_fraction: float
     hertz: HertzPoint
     warnings: tuple[str, ...] = field(default=())
@@ -238,8 +248,59 @@ def _clamps(body: str, symmetry: str) -> list[tuple[str, str]]:
     return fixed
 
 
+def hybrid_compliance(
+    op,
+    P,
+    Q,
+    centers: np.ndarray,
+    half_width: float,
+    depth: float,
+    E: float,
+    nu: float,
+    quarter: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Hybrid compliance of one body: coarse FE below a matching depth, half-space above it.
+
+    Following Vijayakar (1991, IJNME 31, 525: a combined surface integral and finite element
+    solution of 3-D contact), the approach of cell ``i`` under the cell forces is split at a
+    matching point ``y_i = x_i + d e_i`` at depth ``d`` below the cell centre ``x_i``:
+
+    .. math::
+
+        w_i = \\underbrace{Q_i^T K^{-1} P F}_{\\text{FE at depth } d}
+            + \\underbrace{\\sum_j \\big[u^{hs}(x_i; j) - u^{hs}(y_i; j)\\big] F_j}
+              _{\\text{half-space compression of the top layer}} .
+
+    The FE is accurate at ``y_i`` when ``d`` is a few element sizes (there the coarse mesh no
+    longer has to resolve the pressure's near field), and the half-space is accurate for the
+    layer ``[0, d]`` when ``d`` is small against the body's radii; the FE's own (wrong) near field
+    is what the matching removes: the part the coarse FE carries above ``y_i`` is never used.
+    With ``d`` tied to the element size (``HYBRID_DEPTH_ELEMENTS``) the correction layer shrinks
+    as the FE is refined, so the hybrid tends to the pure FE answer. The FE part is not exactly
+    symmetric; the symmetric part is used. With quarter symmetry the half-space terms include the
+    three mirror images of every cell (the FE carries them through its symmetry conditions).
+
+    Returns the (n, n) compliance and its half-space part.
+    """
+    C_fe = cross_compliance(op, Q, P)
+    hw = np.full((centers.shape[0], 2), half_width)
+    images = [(1, 1), (1, -1), (-1, 1), (-1, -1)] if quarter else [(1, 1)]
+    near = np.zeros_like(C_fe)
+    for sx, sy in images:
+        c_img = centers * [sx, sy]
+        near += subsurface_influence(centers, 0.0, c_img, hw, E, nu)
+        near -= subsurface_influence(centers, depth, c_img, hw, E, nu)
+    C = 0.5 * (C_fe + C_fe.T) + 0.5 * (near + near.T)
+    return C, near
+
+
 def run_level(
-    scene: HertzScene, level: int, backend: str = "auto", with_fields: bool = False
+    scene: HertzScene,
+    level: int,
+    backend: str = "auto",
+    with_fields: bool = False,
+    fidelity: str = "fe",
+    fe_level: int = 0,
 ) -> HertzLevelResult:
     """Solve the scene at one level (0 = coarsest) and compare with Hertz.
 
@@ -254,7 +315,15 @@ def run_level(
     with_fields
         Also compute the displacement fields of both bodies (one extra sparse solve each), for
         the VTK output.
+    fidelity
+        ``"fe"``: the compliance of each body is pure FE on the level's grid and a mesh refined
+        to match it. ``"hybrid"``: the grid of the level, but the FE mesh of ``fe_level``, with
+        the near field of every body replaced by the half-space (:func:`hybrid_compliance`).
+    fe_level
+        With ``fidelity="hybrid"``, the level whose (coarse) FE mesh is used.
     """
+    if fidelity not in ("fe", "hybrid"):
+        raise InputError("fidelity", fidelity, "'fe' or 'hybrid'")
     if not (isinstance(level, int) and 0 <= level < len(CELLS_ACROSS_MINOR)):
         raise InputError("level", level, f"an integer in [0, {len(CELLS_ACROSS_MINOR) - 1}]")
     t_start = time.perf_counter()
@@ -263,7 +332,8 @@ def run_level(
     s = 2.0 * ref.b_mm / n_minor
     centers, qp, qw = _grid(scene, ref, s)
     n = centers.shape[0]
-    spec = _mesh_spec(scene, ref, s)
+    s_fe = s if fidelity == "fe" else 2.0 * ref.b_mm / CELLS_ACROSS_MINOR[fe_level]
+    spec = _mesh_spec(scene, ref, s_fe)
     Rx, Ry = scene.roller_radii_mm
     seconds: dict[str, float] = {}
     warnings: list[str] = []
@@ -302,12 +372,30 @@ def run_level(
         direction = np.tile([0.0, 0.0, -1.0 if name == "block" else 1.0], (n, 1))
         P = load_operator(body, "contact", pts, qw, direction)
         key = {"mesh": path.name, "clamped": clamped}
-        op = candidate_operator(body, np.unique(P.nonzero()[0]), backend=backend, cache_key=key)
+        if fidelity == "fe":
+            op = candidate_operator(body, np.unique(P.nonzero()[0]), backend=backend, cache_key=key)
+            C += body_compliance(op, P)
+        else:
+            depth = HYBRID_DEPTH_ELEMENTS * spec.h_fine
+            surf = np.column_stack(
+                [
+                    centers,
+                    roller_height(centers[:, 0], centers[:, 1], Rx, Ry)
+                    if name == "roller"
+                    else np.zeros(n),
+                ]
+            )
+            Q = probe_operator(body, surf + depth * direction, direction)
+            cand = np.union1d(np.unique(P.nonzero()[0]), np.unique(Q.nonzero()[0]))
+            op = candidate_operator(body, cand, backend=backend, cache_key=key)
+            Cb, near = hybrid_compliance(
+                op, P, Q, centers, 0.5 * s, depth, E, nu, quarter=scene.symmetry == "quarter"
+            )
+            C += Cb
         seconds["operator"] += op.seconds - body.assembly_seconds
         seconds["assembly"] += body.assembly_seconds
         hits.append(op.cache_hit)
         used_backend = op.backend if op.backend != "cache" else used_backend or "cache"
-        C += body_compliance(op, P)
         dofs[name] = body.n_dofs
         bodies[name] = (body, P)
 
@@ -377,6 +465,7 @@ def run_level(
         pressure=pressure,
         force=sol.force,
         symmetry=scene.symmetry,
+        fidelity=fidelity,
         modelled_fraction=fraction,
         hertz=ref,
         warnings=tuple(warnings),
