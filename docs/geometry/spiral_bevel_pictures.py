@@ -54,6 +54,27 @@ def flank_grids(pair: SpiralBevelPair, member: str, path: dict) -> Path:
     return out
 
 
+def flank_vtk(pair: SpiralBevelPair, member: str) -> Path:
+    """Both flanks of one tooth as a VTK multiblock of structured grids (points, normals,
+    principal curvatures, meshing residual), ``spiral_bevel_<member>.vtm`` for ParaView."""
+    import pyvista as pv
+
+    m = getattr(pair, member)
+    blocks = pv.MultiBlock()
+    for side in ("drive", "coast"):
+        fl = m.flank(side, 21, 15)
+        P = fl.points
+        grid = pv.StructuredGrid(P[..., 0], P[..., 1], P[..., 2])
+        grid.point_data["normal"] = fl.normals.reshape(-1, 3, order="F")
+        grid.point_data["kappa_1_per_mm"] = fl.kappa[..., 0].ravel(order="F")
+        grid.point_data["kappa_2_per_mm"] = fl.kappa[..., 1].ravel(order="F")
+        grid.point_data["meshing_residual"] = fl.meshing_residual.ravel(order="F")
+        blocks[side] = grid
+    out = HERE / f"spiral_bevel_{member}.vtm"
+    blocks.save(out)
+    return out
+
+
 def main() -> None:
     logging.basicConfig(level=logging.INFO)
     pair = SpiralBevelPair.design()
@@ -76,6 +97,7 @@ def main() -> None:
     plt.close(fig)
     for member in ("pinion", "gear"):
         log.info("wrote %s", flank_grids(pair, member, paths[member]))
+        log.info("wrote %s", flank_vtk(pair, member))
 
 
 if __name__ == "__main__":
