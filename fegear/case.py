@@ -53,6 +53,18 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], bool]]] = {
     "study": {"levels": (list, False)},
 }
 _REQUIRED_SECTIONS = ("case", "load", "roller")
+# HertzScene field -> the case-file key that sets it (errors name what the user wrote)
+_SCENE_KEYS = {
+    "force_N": "load.force_N",
+    "roller_half_length_mm": "roller.half_length_mm",
+    "block_half_size_mm": "block.half_size_mm",
+    "block_height_mm": "block.height_mm",
+    "E_roller_MPa": "roller.E_MPa",
+    "nu_roller": "roller.nu",
+    "E_block_MPa": "block.E_MPa",
+    "nu_block": "block.nu",
+    "mesh.symmetry": "mesh.symmetry",
+}
 
 
 @dataclass(frozen=True)
@@ -121,19 +133,26 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
     if len(radii) != 2 or not all(isinstance(r, _NUM) and not isinstance(r, bool) for r in radii):
         raise InputError("roller.radii_mm", radii, "a list of two numbers [Rx, Ry]")
     defaults = HertzScene()
-    scene = HertzScene(
-        force_N=float(sections["load"]["force_N"]),
-        roller_radii_mm=(float(radii[0]), float(radii[1])),
-        roller_half_length_mm=float(roller.get("half_length_mm", defaults.roller_half_length_mm)),
-        block_half_size_mm=float(block.get("half_size_mm", defaults.block_half_size_mm)),
-        block_height_mm=float(block.get("height_mm", defaults.block_height_mm)),
-        E_roller_MPa=float(roller.get("E_MPa", defaults.E_roller_MPa)),
-        nu_roller=float(roller.get("nu", defaults.nu_roller)),
-        E_block_MPa=float(block.get("E_MPa", defaults.E_block_MPa)),
-        nu_block=float(block.get("nu", defaults.nu_block)),
-        symmetry=str(mesh.get("symmetry", defaults.symmetry)),
-        grid_margin=float(mesh.get("grid_margin", defaults.grid_margin)),
-    )
+    try:
+        scene = HertzScene(
+            force_N=float(sections["load"]["force_N"]),
+            roller_radii_mm=(float(radii[0]), float(radii[1])),
+            roller_half_length_mm=float(
+                roller.get("half_length_mm", defaults.roller_half_length_mm)
+            ),
+            block_half_size_mm=float(block.get("half_size_mm", defaults.block_half_size_mm)),
+            block_height_mm=float(block.get("height_mm", defaults.block_height_mm)),
+            E_roller_MPa=float(roller.get("E_MPa", defaults.E_roller_MPa)),
+            nu_roller=float(roller.get("nu", defaults.nu_roller)),
+            E_block_MPa=float(block.get("E_MPa", defaults.E_block_MPa)),
+            nu_block=float(block.get("nu", defaults.nu_block)),
+            symmetry=str(mesh.get("symmetry", defaults.symmetry)),
+            grid_margin=float(mesh.get("grid_margin", defaults.grid_margin)),
+        )
+    except InputError as exc:
+        if exc.field not in _SCENE_KEYS:
+            raise
+        raise InputError(_SCENE_KEYS[exc.field], exc.value, exc.allowed) from exc
     nlev = len(CELLS_ACROSS_MINOR)
     level = mesh.get("level", 3)
     if not 0 <= level < nlev:

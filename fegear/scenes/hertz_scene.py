@@ -101,6 +101,10 @@ class HertzScene:
         for i, r in enumerate(self.roller_radii_mm):
             if r is None or not math.isfinite(r) or r <= 0:
                 raise InputError(f"roller.radii_mm[{i}]", r, "a finite radius > 0 mm")
+        if self.roller_radii_mm[0] > self.roller_radii_mm[1]:
+            raise InputError(
+                "roller.radii_mm", self.roller_radii_mm, "Rx <= Ry (major axis along y)"
+            )
         for name in ("roller_half_length_mm", "block_half_size_mm", "block_height_mm"):
             v = getattr(self, name)
             if not math.isfinite(v) or v <= 0:
