@@ -1,0 +1,18 @@
+"""Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair (DESIGN §7-§10)."""
+
+from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, run_ltca, solve_position
+from fegear.ltca.grid import PairCells, pair_cells
+from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
+
+__all__ = [
+    "LTCAOptions",
+    "MemberModels",
+    "build_models",
+    "run_ltca",
+    "solve_position",
+    "PairCells",
+    "pair_cells",
+    "LoadedCycle",
+    "LoadedPosition",
+    "PairLoad",
+]

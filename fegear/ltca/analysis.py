@@ -1,0 +1,333 @@
+"""The loaded mesh cycle: TCA gaps + FE compliance of both sectors + torque-balanced contact.
+
+At each mesh position (DESIGN §8):
+
+1. the TCA closes the smallest gap of all pairs (unloaded TE) and gives the coarse separation
+   field of every pair that can engage;
+2. every pair gets fine contact cells where its separation is below ``g_max``
+   (:func:`fegear.ltca.grid.pair_cells`);
+3. the compliance of all cells is ``C = C_pinion + C_gear`` with ``C_m = P_mᵀ (K_m⁻¹)_cc P_m``
+   on the member's cached operator (the force of a cell acts along ``−n1`` on the pinion and
+   ``+n1`` on the gear, ``n1`` the pinion's outward normal); cells of different pairs are coupled
+   through the bodies;
+4. :func:`fegear.contact.solve_contact` solves ``d = g − θ h + C F ≥ 0, F ≥ 0, F·d = 0`` with
+   torque balance ``hᵀF = T2``: ``θ`` is the elastic lag of member 2, and the number of pairs in
+   contact is whatever the active set says;
+5. ``g_max`` is checked afterwards: a coarse TCA cell left out (separation above ``g_max``) whose
+   rigid gap after the lag, ``g − θ h``, is negative could have taken load; ``g_max`` is then
+   doubled and the position solved again (the elastic term ``C F`` only opens such gaps further,
+   so the rigid test is conservative).
+
+The loaded TE is the unloaded TE minus the lag ``θ`` (arcsec).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from fegear.contact import solve_contact
+from fegear.errors import InputError
+from fegear.ltca.grid import PairCells, pair_cells
+from fegear.ltca.model import (
+    MemberModel,
+    build_member_model,
+    member_compliance,
+    member_load_operator,
+)
+from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
+from fegear.mesh.sector import sector_mesh
+from fegear.patch import measure_patch
+from fegear.tca import TCA, TCAOptions, reference_phase
+from fegear.tca.results import ARCSEC, PositionResult
+
+__all__ = ["LTCAOptions", "MemberModels", "build_models", "solve_position", "run_ltca"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class LTCAOptions:
+    """Options of the loaded analysis.
+
+    Attributes
+    ----------
+    n_positions
+        Positions per mesh cycle.
+    level
+        Sector mesh level (0 coarse … 4 fine).
+    n_teeth
+        Teeth per sector (contact ratio + one neighbour each side; 3 covers contact ratios < 2).
+    cell_mm
+        Contact cell size; None: half the fine element size of the coarser member.
+    g_max_mm
+        Initial separation cut-off (doubled automatically while too small).
+    tca_grid
+        Coarse separation grid of the TCA (nu, nv).
+    E_MPa, nu
+        Material of both members.
+    backend
+        Sparse direct backend.
+    """
+
+    n_positions: int = 25
+    level: int = 0
+    n_teeth: int = 3
+    cell_mm: float | None = None
+    g_max_mm: float = 0.02
+    tca_grid: tuple[int, int] = (24, 12)
+    E_MPa: float = 206000.0
+    nu: float = 0.3
+    backend: str = "auto"
+
+
+@dataclass(frozen=True)
+class MemberModels:
+    """FE models of both members and the cell size that goes with them."""
+
+    pinion: MemberModel
+    gear: MemberModel
+    cell_mm: float
+    seconds: float
+
+
+def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
+    """Mesh both sectors and compute their compliance operators (cached)."""
+    t0 = time.perf_counter()
+    models = []
+    for member, side in ((pinion, assembly.side1), (gear, assembly.side2)):
+        sm = sector_mesh(member, options.n_teeth, options.level)
+        models.append(
+            build_member_model(member.name, sm, side, options.E_MPa, options.nu, options.backend)
+        )
+    h = min(float(m.sector.parameters["h_fine_mm"]) for m in models)
+    cell = options.cell_mm if options.cell_mm is not None else 0.5 * h
+    return MemberModels(models[0], models[1], cell, time.perf_counter() - t0)
+
+
+def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
+    from fegear.contact import ContactSolution
+
+    empty = ContactSolution(
+        force=np.zeros(0),
+        gap=np.zeros(0),
+        active=np.zeros(0, dtype=bool),
+        theta=0.0,
+        iterations=0,
+        equilibrium_residual=0.0,
+        complementarity_residual=0.0,
+        max_penetration=0.0,
+        min_active_force=0.0,
+    )
+    te = pos.te_arcsec
+    return LoadedPosition(
+        phi1=pos.phi1,
+        te_unloaded_arcsec=te,
+        te_loaded_arcsec=te,
+        theta=0.0,
+        pairs=(),
+        cells=(),
+        pressure=(),
+        solution=empty,
+        g_max_mm=0.0,
+        warnings=(reason,),
+    )
+
+
+def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
+    for g in pos.grids:
+        out = g.valid & (g.separation > g_max)
+        if np.any(g.separation[out] - theta * g.h[out] < 0.0):
+            return True
+    return False
+
+
+def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
+    """Cells of every modelled pair within ``g_max`` and their contact solution."""
+    asm = tca.asm
+    M1 = asm.placement1(pos.phi1)
+    M2 = asm.placement2(pos.phi2)
+    cells: list[PairCells] = []
+    for gi, g in enumerate(pos.grids):
+        if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
+            n = models.pinion.sector.n_teeth
+            msg = f"pair ({g.k}, {g.j}) lies outside the {n}-tooth sectors"
+            if msg not in warnings:
+                warnings.append(msg)
+                log.warning(msg)
+            continue
+        c = pair_cells(tca, pos, gi, cell, g_max)
+        if c is not None:
+            cells.append(c)
+    if not cells:
+        return cells, None
+    P1 = sp.hstack(
+        [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
+    ).tocsr()
+    P2 = sp.hstack(
+        [
+            member_load_operator(
+                models.gear,
+                M2,
+                c.j,
+                c.quad_points + c.gap[:, None, None] * c.normals[:, None],
+                c.normals,
+            )
+            for c in cells
+        ]
+    ).tocsr()
+    C = member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
+    gap = np.concatenate([c.gap for c in cells])
+    h = np.concatenate([c.h for c in cells])
+    return cells, solve_contact(C, gap, torque2_Nmm, weights=h)
+
+
+def solve_position(
+    tca: TCA,
+    pos: PositionResult,
+    models: MemberModels,
+    torque2_Nmm: float,
+    g_max_mm: float,
+) -> LoadedPosition:
+    """Loaded contact at one TCA position (see the module docstring)."""
+    if not pos.has_contact:
+        return _no_contact(pos, "no contact: the flanks do not meet at this position")
+    warnings: list[str] = []
+    # Pass 1: cells of the default size; g_max doubled until no left-out cell could touch.
+    g_max = g_max_mm
+    cell = (models.cell_mm, models.cell_mm)
+    for _attempt in range(8):
+        cells, sol = _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings)
+        if sol is None:
+            return _no_contact(pos, "no contact cells within g_max")
+        if not _excluded_violation(pos, g_max, sol.theta):
+            break
+        g_max *= 2.0
+        log.info("phi1 = %.4f: g_max raised to %.4g mm", pos.phi1, g_max)
+    else:
+        warnings.append(f"g_max did not settle (last {g_max:.3g} mm)")
+    # Per-pair results.
+    loads, pressures = [], []
+    start = 0
+    for c in cells:
+        F = sol.force[start : start + c.n]
+        act = sol.active[start : start + c.n]
+        start += c.n
+        p = F / c.area
+        pressures.append(p)
+        f_tot = float(F.sum())
+        if f_tot > 0.0:
+            pm = measure_patch(c.local, F, c.area)
+            centroid = (F @ c.centers) / f_tot
+            semi = (pm.semi_major, pm.semi_minor)
+            if 2.0 * pm.semi_minor < 4.0 * float(c.cell_mm.min()):
+                msg = (
+                    f"pair ({c.k}, {c.j}) at phi1 = {np.degrees(pos.phi1):.3f} deg: contact "
+                    f"grid too coarse for the patch: "
+                    f"{2 * pm.semi_minor / c.cell_mm.min():.1f} cells across the minor axis"
+                )
+                warnings.append(msg)
+            p_peak = pm.p_peak
+        else:
+            centroid, semi, p_peak = np.zeros(3), (0.0, 0.0), 0.0
+        loads.append(
+            PairLoad(
+                k=c.k,
+                j=c.j,
+                force_N=f_tot,
+                torque_Nmm=float(c.h @ F),
+                load_share=float(c.h @ F) / torque2_Nmm,
+                p_max_MPa=float(p.max()),
+                p_peak_MPa=float(p_peak),
+                semi_major_mm=semi[0],
+                semi_minor_mm=semi[1],
+                n_active=int(act.sum()),
+                edge_contact=bool(np.any(act & c.boundary)),
+                contact_point=centroid,
+            )
+        )
+    te_l = pos.te_arcsec - sol.theta / ARCSEC
+    return LoadedPosition(
+        phi1=pos.phi1,
+        te_unloaded_arcsec=pos.te_arcsec,
+        te_loaded_arcsec=te_l,
+        theta=sol.theta,
+        pairs=tuple(loads),
+        cells=tuple(cells),
+        pressure=tuple(pressures),
+        solution=sol,
+        g_max_mm=g_max,
+        warnings=tuple(warnings),
+    )
+
+
+def run_ltca(
+    pinion,
+    gear,
+    assembly,
+    torque2_Nmm: float,
+    options: LTCAOptions | None = None,
+    phi1: np.ndarray | None = None,
+    models: MemberModels | None = None,
+    progress=None,
+) -> LoadedCycle:
+    """Loaded tooth contact analysis over one mesh cycle (or at the pinion angles ``phi1``).
+
+    Parameters
+    ----------
+    pinion, gear
+        Generated members.
+    assembly
+        The assembled pair (:mod:`fegear.assembly`), with its installation errors.
+    torque2_Nmm
+        Resisting torque on member 2 (N·mm, > 0).
+    options
+        :class:`LTCAOptions`.
+    phi1
+        Pinion angles (rad); default ``n_positions`` over one cycle ``[−π/N1, π/N1)``.
+    models
+        Pre-built member models (to reuse over several torques).
+    progress
+        Optional callable ``progress(i, n)`` called after each position.
+    """
+    if not (np.isfinite(torque2_Nmm) and torque2_Nmm > 0):
+        raise InputError("torque2_Nmm", torque2_Nmm, "a finite number > 0")
+    opt = options or LTCAOptions()
+    seconds: dict[str, float] = {}
+    t0 = time.perf_counter()
+    tca_opt = TCAOptions(
+        n_positions=opt.n_positions, separation_grid=opt.tca_grid, E_MPa=opt.E_MPa, nu=opt.nu
+    )
+    asm = assembly.with_phase2(reference_phase(pinion, gear, assembly, tca_opt))
+    tca = TCA(pinion, gear, asm, tca_opt)
+    if phi1 is None:
+        n = opt.n_positions
+        phi1 = -np.pi / asm.n1 + 2 * np.pi / asm.n1 * np.arange(n) / n
+    phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
+    tca_pos = tca.positions(phi1)
+    seconds["tca"] = time.perf_counter() - t0
+    if models is None:
+        models = build_models(pinion, gear, asm, opt)
+    seconds["models"] = models.seconds
+    t0 = time.perf_counter()
+    out = []
+    for i, pos in enumerate(tca_pos):
+        out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm))
+        if progress is not None:
+            progress(i + 1, len(tca_pos))
+    seconds["positions"] = time.perf_counter() - t0
+    return LoadedCycle(
+        positions=tuple(out),
+        torque2_Nmm=float(torque2_Nmm),
+        phi1=phi1,
+        te_unloaded_arcsec=np.array([p.te_unloaded_arcsec for p in out]),
+        te_loaded_arcsec=np.array([p.te_loaded_arcsec for p in out]),
+        n_in_contact=np.array([p.n_pairs_in_contact for p in out], dtype=int),
+        fidelity="fe",
+        level=opt.level,
+        seconds=seconds,
+    )

@@ -1,0 +1,126 @@
+"""FE compliance of the two members of a gear pair, computed once per sector.
+
+Each member is a sector of ``n`` teeth (:mod:`fegear.mesh.sector`) in its own frame, clamped at the
+bore (or the face-gear base) and at both sector cuts. The candidate DOFs are all DOFs of the
+nodes on the working flanks of the teeth that can engage: the flank points move with the teeth,
+so one Schur complement (``(K⁻¹)_cc``) serves every mesh position and every torque
+(:func:`fegear.compliance.candidate_operator`, cached on disk by content hash). A mesh position
+then costs only locating its cells on the flank facets (sparse ``P``) and ``C = Pᵀ G P``.
+
+Tooth numbering: member tooth ``k`` is sector tooth ``k + n // 2`` (the sector's centre tooth is
+member tooth 0); a pair whose tooth falls outside the sector cannot be modelled and is reported.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from fegear.compliance import CandidateOperator, body_compliance, candidate_operator, load_operator
+from fegear.errors import InputError
+from fegear.fem.elasticity import ElasticBody, assemble_body, boundary_dofs
+from fegear.geometry.transforms import apply_points, apply_vectors, inverse
+from fegear.mesh.sector import SectorMesh
+
+__all__ = ["MemberModel", "build_member_model", "member_load_operator", "member_compliance"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class MemberModel:
+    """One member's FE model over its potential-contact flanks.
+
+    Attributes
+    ----------
+    name
+        Member name.
+    sector
+        The sector mesh (member frame).
+    body
+        The elastic body (bases, free DOFs; stiffness assembled only when the operator is built).
+    op
+        ``(K⁻¹)_cc`` on the DOFs of the working flanks of the sector teeth.
+    side
+        Working flank side ("drive" or "coast").
+    """
+
+    name: str
+    sector: SectorMesh
+    body: ElasticBody
+    op: CandidateOperator
+    side: str
+
+    def boundary_of(self, tooth: int) -> str:
+        """Boundary name of member tooth ``tooth``'s working flank in the sector."""
+        t = tooth + self.sector.centre_tooth
+        if not 0 <= t < self.sector.n_teeth:
+            raise InputError("tooth", tooth, f"within the sector's {self.sector.n_teeth} teeth")
+        return f"flank_{self.side}_{t}"
+
+    def has_tooth(self, tooth: int) -> bool:
+        return 0 <= tooth + self.sector.centre_tooth < self.sector.n_teeth
+
+
+def build_member_model(
+    name: str, sector: SectorMesh, side: str, E: float, nu: float, backend: str = "auto"
+) -> MemberModel:
+    """Assemble a sector and compute ``(K⁻¹)_cc`` on all its working-flank DOFs."""
+    mesh = sector.to_skfem()
+    support = "base" if "base" in mesh.boundaries else "bore"
+    clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
+    body = assemble_body(mesh, E, nu, clamped)
+    flanks = [f"flank_{side}_{t}" for t in range(sector.n_teeth)]
+    dofs = np.unique(np.concatenate([boundary_dofs(body.basis, f) for f in flanks]))
+    key = {
+        "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
+        "clamped": clamped,
+        "flanks": flanks,
+    }
+    op = candidate_operator(body, dofs, backend=backend, cache_key=key)
+    log.info(
+        "%s: %d DOFs, %d candidate DOFs, operator in %.1f s (%s)",
+        name,
+        body.n_dofs,
+        op.dofs.size,
+        op.seconds,
+        op.backend,
+    )
+    return MemberModel(name=name, sector=sector, body=body, op=op, side=side)
+
+
+def member_load_operator(
+    model: MemberModel,
+    placement: np.ndarray,
+    tooth: int,
+    quad_points: np.ndarray,
+    directions: np.ndarray,
+) -> sp.csr_matrix:
+    """Consistent-load matrix ``P`` (n_dofs × n) of one pair's cells on one member.
+
+    Parameters
+    ----------
+    model
+        The member model.
+    placement
+        (4, 4) member frame → fixed frame at this position.
+    tooth
+        Member tooth carrying the cells.
+    quad_points
+        (n, q, 3) fixed frame, quadrature points of the cells on this member's flank.
+    directions
+        (n, 3) fixed frame, unit direction of the cell force on this member (into the member).
+    """
+    Minv = inverse(placement)
+    pts = apply_points(Minv, quad_points)
+    e = apply_vectors(Minv, directions)
+    n, q = pts.shape[:2]
+    return load_operator(model.body, model.boundary_of(tooth), pts, np.full((n, q), 1.0 / q), e)
+
+
+def member_compliance(model: MemberModel, P: sp.csr_matrix) -> np.ndarray:
+    """``C = Pᵀ (K⁻¹) P`` of all cells on this member (cross-tooth coupling included)."""
+    return body_compliance(model.op, P)
