@@ -234,16 +234,44 @@ def _shape_operator(
     return P
 
 
+def find_tets(
+    mesh: skfem.MeshTet, points: np.ndarray, k: int = 16
+) -> tuple[np.ndarray, np.ndarray]:
+    """Tetrahedron containing each point (-1 if none of the ``k`` nearest by centroid does) and
+    the point's reference coordinates in it. Vectorised barycentric test."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    cen = mesh.p[:, mesh.t].mean(axis=1).T
+    kk = min(k, cen.shape[0])
+    _, cand = cKDTree(cen).query(pts, k=kk)
+    cand = cand.reshape(pts.shape[0], kk)
+    tv = np.moveaxis(mesh.p[:, mesh.t[:, cand]], 0, -1)  # (4, npts, kk, 3)
+    J = np.stack([tv[1] - tv[0], tv[2] - tv[0], tv[3] - tv[0]], axis=-1)  # (npts, kk, 3, 3)
+    xi = np.linalg.solve(J, (pts[:, None, :] - tv[0])[..., None])[..., 0]
+    bmin = np.minimum(xi.min(axis=-1), 1.0 - xi.sum(axis=-1))
+    best = np.argmax(bmin, axis=1)
+    rows = np.arange(pts.shape[0])
+    ok = bmin[rows, best] >= -1e-9
+    tets = np.where(ok, cand[rows, best], -1)
+    return tets, xi[rows, best]
+
+
 def locate_inside(mesh: skfem.MeshTet, points: np.ndarray) -> SurfacePoints:
     """Tetrahedra and reference coordinates of interior points (``distance`` is zero)."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
-    try:
-        tets = mesh.element_finder()(pts[:, 0], pts[:, 1], pts[:, 2])
-    except ValueError as exc:
-        raise InputError("points", "outside the mesh", "inside the body") from exc
-    tv = mesh.p[:, mesh.t[:, tets]].transpose(2, 1, 0)
-    J = np.stack([tv[:, 1] - tv[:, 0], tv[:, 2] - tv[:, 0], tv[:, 3] - tv[:, 0]], axis=-1)
-    xi = np.linalg.solve(J, (pts - tv[:, 0])[..., None])[..., 0]
+    tets, xi = find_tets(mesh, pts)
+    miss = np.flatnonzero(tets < 0)
+    if miss.size:  # graded meshes: the containing tet may not be among the nearest centroids
+        try:
+            t = mesh.element_finder()(pts[miss, 0], pts[miss, 1], pts[miss, 2])
+        except ValueError:
+            t = None
+        if t is not None:
+            tv = np.moveaxis(mesh.p[:, mesh.t[:, t]], 0, -1)  # (4, n, 3)
+            J = np.stack([tv[1] - tv[0], tv[2] - tv[0], tv[3] - tv[0]], axis=-1)
+            xi[miss] = np.linalg.solve(J, (pts[miss] - tv[0])[..., None])[..., 0]
+            tets[miss] = t
+    if np.any(tets < 0):
+        raise InputError("points", f"{int(np.sum(tets < 0))} outside the mesh", "inside the body")
     return SurfacePoints(tets=tets, local=xi, distance=np.zeros(pts.shape[0]))
 
 

@@ -135,8 +135,9 @@ def test_contact_solution_invariants(coarse, level):
 def test_repeated_run_on_a_warm_cache_is_bit_identical(coarse):
     first = coarse[0]
     again = run_level(NOMINAL, 0)
-    # The second run reads the meshes and compliance operators back from the cache ...
-    assert again.cache_hit and not first.cache_hit
+    # The second run reads the meshes and compliance operators back from the cache (the first
+    # may or may not have, depending on which tests ran before in this session) ...
+    assert again.cache_hit
     # ... and the contact solve is deterministic: the same bits, not merely close.
     assert np.array_equal(again.force, first.force)
     assert np.array_equal(again.solution.active, first.solution.active)

@@ -67,6 +67,93 @@ def face_gear() -> None:
             rr.edge.sum()))  # fmt: skip
 
 
+def spiral_bevel() -> None:
+    """Reference spiral bevel (12/36): TE of all pairs with the transfer points, contact paths on
+    the gear flank (error-free and ±ΔE, ±ΔG), and the error table of README.md."""
+    import math
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fegear.assembly import spiral_bevel_assembly
+    from fegear.geometry.spiral_bevel import SpiralBevelPair
+    from fegear.tca.bevel import cycle_angles, error_effects, path_angle_on_gear, te_parabola
+
+    pair = SpiralBevelPair.design()
+    n1 = pair.blank.n1
+    phi = cycle_angles(n1, 41, margin=0.25)
+    nom = run_tca(pair.pinion, pair.gear, spiral_bevel_assembly(pair, "drive"), TCAOptions(),
+                  phi1=phi)  # fmt: skip
+    cases = {}
+    for sg in (1, -1):
+        cases[f"ΔE = {sg * 0.05:+.2f} mm"] = InstallationErrors(dE_mm=sg * 0.05)
+        cases[f"ΔP = {sg * 0.05:+.2f} mm"] = InstallationErrors(dA1_mm=sg * 0.05)
+        cases[f"ΔG = {sg * 0.05:+.2f} mm"] = InstallationErrors(dA2_mm=sg * 0.05)
+        cases[f"Δγ = {sg * 0.02:+.2f}°"] = InstallationErrors(dgamma_deg=sg * 0.02)
+    ref, eff, runs = error_effects(pair, cases, "drive", n_positions=25)
+    xv, tv, amp, rms = te_parabola(nom, n1)
+    eta, eta0 = path_angle_on_gear(pair, "drive")
+    print(f"nominal: amplitude {amp:.3f} arcsec (fit rms {rms:.4f}), vertex {math.degrees(xv):.3f}"
+          f" deg / {tv:.4f} arcsec, TE p-p {nom.te_peak_to_peak_arcsec:.3f}; transfer points "
+          f"{np.degrees(nom.transfer_points[:, 0])} deg at {nom.transfer_points[:, 1]} arcsec; "
+          f"path angle {eta:.3f} deg (design {eta0})")  # fmt: skip
+    print("| error | pattern ΔL (mm, + heel) | pattern Δh (mm, + top) | TE p-p (arcsec) | "
+          "parabola vertex φ* (deg) | TE(φ*) (arcsec) | amplitude (arcsec) | TE(0) TCA / "
+          "1st-order theory (arcsec) |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    print(f"| none | 0 | 0 | {ref.te_peak_to_peak_arcsec:.2f} | {math.degrees(te_parabola(ref, n1)[0]):+.2f} | "  # noqa: E501
+          f"{te_parabola(ref, n1)[1]:+.2f} | {te_parabola(ref, n1)[2]:.2f} | 0 / 0 |")  # fmt: skip
+    for lab, e in eff.items():
+        print(f"| {lab} | {e.dL_mm:+.3f} | {e.dh_mm:+.3f} | {e.te_pp_arcsec:.2f} | "
+              f"{e.vertex_deg:+.2f} | {e.vertex_te_arcsec:+.2f} | {e.amplitude_arcsec:.2f} | "
+              f"{e.te0_arcsec:+.2f} / {e.te0_first_order_arcsec:+.2f} |")  # fmt: skip
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.6))
+    deg = np.degrees(nom.phi1)
+    for k in range(nom.pairs.shape[0]):
+        m = nom.pair_valid[:, k] & (nom.pair_te_arcsec[:, k] > -30)
+        ax1.plot(deg[m], nom.pair_te_arcsec[m, k], ":", lw=1.2, label=f"pair {k - 1:+d}")
+    ax1.plot(deg, nom.te_arcsec, "k-", lw=2, label="TE (min over pairs)")
+    tp = nom.transfer_points
+    ax1.plot(np.degrees(tp[:, 0]), tp[:, 1], "ro", label="transfer points")
+    for x, y in tp:
+        ax1.annotate(f"{np.degrees(x):+.2f}°", (np.degrees(x), y), textcoords="offset points",
+                     xytext=(-20, -14), fontsize=8)  # fmt: skip
+    ax1.set_ylim(-14, 1.5)
+    ax1.set_xlabel("pinion angle φ1 (deg)")
+    ax1.set_ylabel("unloaded TE (arcsec)")
+    ax1.set_title(f'spiral bevel 12/36: predesigned parabolic TE ({amp:.2f}" amplitude)')
+    ax1.grid(alpha=0.3)
+    ax1.legend(fontsize=8, loc="lower center")
+    g = pair.gear
+    b = g.boundaries()
+    L = np.linspace(b.v_start, b.v_end, 50)
+    hf, ha = pair.blank.flank_heights(2, L)
+    ax2.plot(np.r_[L, L[::-1], L[0]], np.r_[hf, ha[::-1], hf[0]], "k-", lw=1)
+    ax2.plot(L, 0 * L, "k--", lw=0.5)
+    ax2.annotate("toe", (b.v_start, ha[0]), textcoords="offset points", xytext=(2, 4))
+    ax2.annotate("heel", (b.v_end, ha[-1]), textcoords="offset points", xytext=(-26, 4))
+    show = {"no error": ref}
+    for lab in ("ΔE = +0.05 mm", "ΔE = -0.05 mm", "ΔG = +0.05 mm", "ΔG = -0.05 mm"):
+        show[lab] = runs[lab]
+    for i, (lab, r) in enumerate(show.items()):
+        m = r.has_contact
+        u, v = r.gear_uv[m, 0], r.gear_uv[m, 1]
+        ax2.plot(v, g.height(u, v), "-o", ms=2.5, color=f"C{i}", lw=2 if i == 0 else 1,
+                 label=lab)  # fmt: skip
+    ax2.set_xlabel("cone distance L (mm), toe → heel")
+    ax2.set_ylabel("height above the pitch cone h (mm), root → top")
+    ax2.set_title(f"contact path on the gear (drive) flank; path angle {eta:.2f}° "
+                  f"(design {eta0:.0f}°)")  # fmt: skip
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(HERE / "spiral_bevel_tca.png", dpi=120)
+    plt.close(fig)
+
+
 def PINION_BD(pin):  # noqa: N802
     return pin.boundaries("drive")
 
@@ -76,3 +163,4 @@ if __name__ == "__main__":
     plot_assembly_conventions(HERE / "assembly_conventions.png")
     spur()
     face_gear()
+    spiral_bevel()

@@ -63,7 +63,10 @@ class LTCAOptions:
     n_teeth
         Teeth per sector (contact ratio + one neighbour each side; 3 covers contact ratios < 2).
     cell_mm
-        Contact cell size; None: half the fine element size of the coarser member.
+        Contact cell size; None: the fine element size of the coarser member. Cells much
+        smaller than the P2 elements make the FE compliance ``PᵀK⁻¹P`` rank-deficient (more
+        cells than surface DOFs under them), so the ``fe`` fidelity cannot resolve patches
+        narrower than its elements: that is the ``hybrid`` fidelity's job.
     g_max_mm
         Initial separation cut-off (doubled automatically while too small).
     tca_grid
@@ -104,8 +107,8 @@ def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
         models.append(
             build_member_model(member.name, sm, side, options.E_MPa, options.nu, options.backend)
         )
-    h = min(float(m.sector.parameters["h_fine_mm"]) for m in models)
-    cell = options.cell_mm if options.cell_mm is not None else 0.5 * h
+    h = max(float(m.sector.parameters["h_fine_mm"]) for m in models)
+    cell = options.cell_mm if options.cell_mm is not None else h
     return MemberModels(models[0], models[1], cell, time.perf_counter() - t0)
 
 

@@ -10,7 +10,14 @@ from __future__ import annotations
 from .core import TCA, TCAOptions
 from .cycle import contact_interval, cycle_result, reference_phase, run_tca
 from .results import ARCSEC, ContactEllipseAt, CycleResult, PositionResult, SeparationGrid
-from .surfaces import FaceGearMap, FlankMap, GenericFlankMap, SpurInvoluteMap, flank_map
+from .surfaces import (
+    FaceGearMap,
+    FlankMap,
+    GenericFlankMap,
+    SpiralBevelMap,
+    SpurInvoluteMap,
+    flank_map,
+)
 
 __all__ = [
     "ARCSEC",
@@ -24,6 +31,7 @@ __all__ = [
     "GenericFlankMap",
     "SpurInvoluteMap",
     "FaceGearMap",
+    "SpiralBevelMap",
     "flank_map",
     "contact_interval",
     "cycle_result",
