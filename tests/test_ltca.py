@@ -148,3 +148,20 @@ def test_bad_torque_is_refused(setup):
     for t in (0.0, -1.0, float("nan")):
         with pytest.raises(InputError, match="torque2_Nmm"):
             run_ltca(PINION, GEAR, asm, t, OPTIONS, models=models)
+
+
+def test_loss_of_contact_is_a_result_not_a_crash():
+    """An 8 mm centre-distance increase leaves positions where no flank pair can carry load
+    (contact ratio below one, or contact only at a tooth tip edge): those positions say so."""
+    from fegear.assembly import InstallationErrors
+
+    asm = involute_assembly(PINION, GEAR, InstallationErrors(da_mm=8.0))
+    c = run_ltca(PINION, GEAR, asm, RATED, OPTIONS)
+    empty = [p for p in c.positions if p.n_pairs_in_contact == 0]
+    assert empty, c.n_in_contact
+    for p in empty:
+        assert p.warnings and ("no load" in p.warnings[0] or "no contact" in p.warnings[0])
+        assert np.isfinite(p.te_loaded_arcsec)
+    loaded = [p for p in c.positions if p.n_pairs_in_contact > 0]
+    for p in loaded:
+        assert p.solution.equilibrium_residual < 1e-9

@@ -206,7 +206,14 @@ def solve_position(
     for _attempt in range(8):
         cells, sol = _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings)
         if sol is None:
-            return _no_contact(pos, "no contact cells within g_max")
+            edge = pos.edge[pos.contact_pair] if pos.contact_pair >= 0 else ""
+            why = (
+                f"the unloaded contact is an edge contact ({edge}) that the contact cells on the "
+                "pinion flank do not represent; no load is carried at this position"
+                if edge
+                else f"no contact cell within g_max = {g_max:.3g} mm"
+            )
+            return _no_contact(pos, why)
         if not _excluded_violation(pos, g_max, sol.theta):
             break
         g_max *= 2.0
