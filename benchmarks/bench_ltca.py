@@ -75,8 +75,10 @@ def main() -> None:
     rows = []
     for lv in levels:
         with tempfile.TemporaryDirectory() as cache:
-            rows.append(run(lv, cache))
-        r = rows[-1]
+            r = run(lv, cache)
+        if not r:
+            continue
+        rows.append(r)
         print(
             f"level {lv}: cold {r['t_cold']:.1f} s (models {r['t_models']:.1f} s), "
             f"warm at another torque {r['t_warm_other_torque']:.1f} s",

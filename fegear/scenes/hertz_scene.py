@@ -324,7 +324,8 @@ def run_level(
         to match it. ``"hybrid"``: the grid of the level, but the FE mesh of ``fe_level``, with
         the near field of every body replaced by the half-space (:func:`hybrid_compliance`).
     fe_level
-        With ``fidelity="hybrid"``, the level whose (coarse) FE mesh is used.
+        The level whose FE mesh is used: with ``hybrid`` always (a coarse mesh under a fine
+        grid); with ``fe`` only when finer than ``level`` (elements smaller than the cells).
     """
     if fidelity not in ("fe", "hybrid"):
         raise InputError("fidelity", fidelity, "'fe' or 'hybrid'")
@@ -336,7 +337,10 @@ def run_level(
     s = 2.0 * ref.b_mm / n_minor
     centers, qp, qw = _grid(scene, ref, s)
     n = centers.shape[0]
-    s_fe = s if fidelity == "fe" else 2.0 * ref.b_mm / CELLS_ACROSS_MINOR[fe_level]
+    # The FE mesh: ``fe`` refines it with the grid (or further, with fe_level > level);
+    # ``hybrid`` keeps the mesh of fe_level whatever the grid.
+    mesh_level = max(level, fe_level) if fidelity == "fe" else fe_level
+    s_fe = 2.0 * ref.b_mm / CELLS_ACROSS_MINOR[mesh_level]
     spec = _mesh_spec(scene, ref, s_fe)
     Rx, Ry = scene.roller_radii_mm
     seconds: dict[str, float] = {}
