@@ -60,6 +60,8 @@ def _run(args: argparse.Namespace) -> int:
             scene=HertzScene(),
             level=3,
             backend="auto",
+            fidelity="fe",
+            fe_level=0,
             study_levels=(),
             source="<built-in>",
         )
