@@ -75,6 +75,9 @@ class LTCAOptions:
         Material of both members.
     backend
         Sparse direct backend.
+    fidelity
+        ``"fe"``: the contact grid with the FE compliance. ``"hertz"``: per-pair Hertz laws and
+        lumped FE compliance (:mod:`fegear.ltca.hertz_model`), milliseconds per position.
     """
 
     n_positions: int = 25
@@ -86,6 +89,11 @@ class LTCAOptions:
     E_MPa: float = 206000.0
     nu: float = 0.3
     backend: str = "auto"
+    fidelity: str = "fe"
+
+    def __post_init__(self) -> None:
+        if self.fidelity not in ("fe", "hertz"):
+            raise InputError("fidelity", self.fidelity, "'fe' or 'hertz'")
 
 
 @dataclass(frozen=True)
@@ -151,9 +159,6 @@ def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool
 
 def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
     """Cells of every modelled pair within ``g_max`` and their contact solution."""
-    asm = tca.asm
-    M1 = asm.placement1(pos.phi1)
-    M2 = asm.placement2(pos.phi2)
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
@@ -168,6 +173,17 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
             cells.append(c)
     if not cells:
         return cells, None
+    C = _solve_cells_compliance(tca, pos, models, cells)
+    gap = np.concatenate([c.gap for c in cells])
+    h = np.concatenate([c.h for c in cells])
+    return cells, solve_contact(C, gap, torque2_Nmm, weights=h)
+
+
+def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
+    """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
+    asm = tca.asm
+    M1 = asm.placement1(pos.phi1)
+    M2 = asm.placement2(pos.phi2)
     P1 = sp.hstack(
         [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
     ).tocsr()
@@ -183,10 +199,7 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
             for c in cells
         ]
     ).tocsr()
-    C = member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
-    gap = np.concatenate([c.gap for c in cells])
-    h = np.concatenate([c.h for c in cells])
-    return cells, solve_contact(C, gap, torque2_Nmm, weights=h)
+    return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
 
 
 def solve_position(
@@ -326,7 +339,12 @@ def run_ltca(
     t0 = time.perf_counter()
     out = []
     for i, pos in enumerate(tca_pos):
-        out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm))
+        if opt.fidelity == "hertz":
+            from fegear.ltca.hertz_model import solve_position_hertz
+
+            out.append(solve_position_hertz(tca, pos, models, torque2_Nmm, opt.E_MPa, opt.nu))
+        else:
+            out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm))
         if progress is not None:
             progress(i + 1, len(tca_pos))
     seconds["positions"] = time.perf_counter() - t0
@@ -337,7 +355,7 @@ def run_ltca(
         te_unloaded_arcsec=np.array([p.te_unloaded_arcsec for p in out]),
         te_loaded_arcsec=np.array([p.te_loaded_arcsec for p in out]),
         n_in_contact=np.array([p.n_pairs_in_contact for p in out], dtype=int),
-        fidelity="fe",
+        fidelity=opt.fidelity,
         level=opt.level,
         seconds=seconds,
     )
