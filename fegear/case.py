@@ -14,6 +14,9 @@ Hertz scene (``kind = "hertz_scene"``)::
     [mesh]    level (0..5), symmetry ("quarter" | "none"), grid_margin
     [solver]  backend ("auto" | "pardiso" | "superlu"), fidelity ("fe" | "hybrid"), fe_level
     [study]   levels = [0, 1, 2, ...]   (optional: a mesh-convergence study)
+
+Gear pairs (``kind = "face_gear" | "spur" | "spiral_bevel"``): see :mod:`fegear.io.gear_case`
+(:func:`load_case` returns a :class:`~fegear.io.gear_case.GearCase` for them).
 """
 
 from __future__ import annotations
@@ -26,9 +29,10 @@ from pathlib import Path
 from typing import Any
 
 from fegear.errors import InputError
+from fegear.io.gear_case import GearCase
 from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, HertzScene
 
-__all__ = ["HertzCase", "load_case", "parse_case"]
+__all__ = ["HertzCase", "GearCase", "load_case", "parse_case", "parse_hertz_case"]
 
 _NUM = (int, float)
 
@@ -110,8 +114,21 @@ def _check_section(name: str, table: Any) -> dict[str, Any]:
     return table
 
 
-def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
-    """Validate a parsed TOML document and build the case."""
+def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase | GearCase:
+    """Validate a parsed TOML document and build the case (dispatch on ``[case] kind``)."""
+    from fegear.io.gear_case import GEAR_KINDS, parse_gear_case
+
+    kind = data.get("case", {}).get("kind") if isinstance(data.get("case"), dict) else None
+    if kind in GEAR_KINDS:
+        return parse_gear_case(data, source)
+    if kind is not None and kind != "hertz_scene":
+        allowed = ", ".join(repr(k) for k in ("hertz_scene", *GEAR_KINDS))
+        raise InputError("case.kind", kind, f"one of {allowed}")
+    return parse_hertz_case(data, source)
+
+
+def parse_hertz_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
+    """Validate a parsed Hertz-scene TOML document and build the case."""
     for key in data:
         if key not in _SCHEMA:
             close = difflib.get_close_matches(key, list(_SCHEMA), n=1, cutoff=0.5)
@@ -182,7 +199,7 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
     )
 
 
-def load_case(path: str | Path) -> HertzCase:
+def load_case(path: str | Path) -> HertzCase | GearCase:
     """Read and validate a case file; every problem raises :class:`InputError`."""
     p = Path(path)
     if not p.is_file():

@@ -1,14 +1,26 @@
 """The ``fegear`` command.
 
-``fegear run [CASE] [--level L] [--out DIR] [--study L1,L2,...] [--backend B]`` runs a case and
-writes its results; with no CASE it runs the built-in Hertz scene (crowned roller Rx 20 / Ry 100 mm
-on a block, 2000 N, steel) at level 3. Bad input ends with a one-line message and exit code 2.
+``fegear run [CASE] [--fidelity F] [--level L] [--out DIR]`` runs a case file and writes its
+results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``). The case kind decides
+what runs:
+
+- gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity fe`` or
+  ``hertz``) or the unloaded TCA (``--fidelity tca``; the only one for spiral bevel pairs for now);
+- ``hertz_scene``: the FE Hertz check (``--fidelity fe | hybrid``, ``--study``, ``--backend``).
+
+With no CASE it runs the built-in seed face-gear case (``cases/face_gear_nominal.toml``: N2 160,
+N1 25, m 6.35 mm, 25°, pinion torque 350.14 N·m, fe level 0, 25 positions; about a minute cold on
+2 cores, the sector meshes and compliance operators are then cached).
+
+Progress goes to stderr (stages and positions); ``-q`` keeps only warnings and errors. Bad input
+ends with a one-line message and exit code 2; a failure of the analysis with exit code 1.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from pathlib import Path
@@ -27,8 +39,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"fegear {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="run a case file (default: the built-in Hertz scene)")
-    r.add_argument("case", nargs="?", help="case file (TOML); default: the Hertz scene")
+    r = sub.add_parser("run", help="run a case file (default: the seed face-gear case)")
+    r.add_argument("case", nargs="?", help="case file (TOML); default: the seed face-gear case")
     r.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the case")
     r.add_argument("--out", default="out", help="output folder (default: ./out)")
     r.add_argument("--study", help="comma-separated levels for a mesh-convergence study")
@@ -39,32 +51,116 @@ def _parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--fidelity",
-        choices=["fe", "hybrid"],
-        help="fe: pure FE compliance; hybrid: coarse FE + half-space near field",
+        help="gear pairs: fe (FE loaded TCA) | hertz (per-pair Hertz + lumped FE compliance) | "
+        "tca (unloaded, rigid); "
+        "Hertz scene: fe | hybrid (coarse FE + half-space near field)",
     )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     return p
 
 
 def _run(args: argparse.Namespace) -> int:
-    from fegear.case import HertzCase, load_case
-    from fegear.convergence import observed_rate
-    from fegear.io.hertz_output import write_hertz_outputs
-    from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, HertzScene, run_level
+    from fegear.case import load_case
+    from fegear.io.gear_case import GearCase
 
     if args.case:
         case = load_case(args.case)
     else:
-        case = HertzCase(
-            name="hertz_scene",
-            scene=HertzScene(),
-            level=3,
-            backend="auto",
-            fidelity="fe",
-            fe_level=0,
-            study_levels=(),
-            source="<built-in>",
+        from fegear.io.seed import seed_case
+
+        case = seed_case()
+    if isinstance(case, GearCase):
+        return _run_gear(args, case)
+    return _run_hertz(args, case)
+
+
+def _run_gear(args: argparse.Namespace, case) -> int:
+    from dataclasses import replace
+
+    from fegear.io.gear_case import build_pair
+    from fegear.io.gear_output import write_gear_outputs
+    from fegear.io.gear_run import SPIRAL_BEVEL_FE, run_gear_case
+
+    if args.study:
+        raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
+    if args.backend:
+        case = replace(case, backend=args.backend)
+    out = Path(args.out)
+    say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    fid = args.fidelity or case.fidelity
+    lvl = case.level if args.level is None else args.level
+    if fid not in ("fe", "hertz", "tca"):
+        raise InputError("--fidelity", fid, "'fe', 'hertz' or 'tca' for gear pairs")
+    if not 0 <= lvl <= 4:
+        raise InputError("--level", lvl, "an integer in [0, 4]")
+    if case.kind == "spiral_bevel" and fid == "fe":
+        raise FegearError(SPIRAL_BEVEL_FE)
+    t_start = time.perf_counter()
+    pair = build_pair(case)  # bad design data is refused here, before any output
+    say(
+        f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
+        f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
+        + (f", level {lvl}" if fid == "fe" else "")
+        + f", {case.n_positions} positions, out {out}/"
+    )
+    stage_t = {"t": t_start}
+    if fid == "fe":
+        labels = {
+            "geometry": "[1/5] geometry and assembly",
+            "models": "[2/5] sector meshes and compliance operators (cached after the first run)",
+            "positions": "[3/5] mesh positions (TCA + contact)",
+            "displacements": "[4/5] displacement fields (one sparse solve per member)",
+            "writing": "[5/5] writing outputs",
+        }
+    else:
+        labels = {
+            "geometry": "[1/3] geometry and assembly",
+            "tca": "[2/3] unloaded TCA over the cycle",
+            "writing": "[3/3] writing outputs",
+        }
+
+    def progress(stage: str, i: int | None, n: int | None) -> None:
+        now = time.perf_counter()
+        if stage == "positions" and i:
+            bar = "#" * int(20 * i / n)
+            say(f"    position {i:3d}/{n} [{bar:<20s}] {now - stage_t['t']:6.1f} s")
+            return
+        say(f"{labels.get(stage, stage)} ...  ({now - t_start:.1f} s elapsed)")
+        stage_t["t"] = now
+
+    run = run_gear_case(
+        case, fidelity=args.fidelity, level=args.level, progress=progress, pair=pair
+    )
+    progress("writing", None, None)
+    paths = write_gear_outputs(out, run)
+    if run.cycle is not None:
+        c = run.cycle
+        say(
+            f"    TE p-p unloaded {c.te_pp_unloaded_arcsec:.2f} arcsec, loaded "
+            f"{c.te_pp_loaded_arcsec:.2f} arcsec; loaded contact ratio "
+            f"{c.contact_ratio_loaded:.2f}; p_max {c.p_max_MPa:.0f} MPa"
         )
+        n_warn = sum(bool(p.warnings) for p in c.positions)
+        if n_warn:
+            say(f"    warning: {n_warn} positions with warnings (see summary.json)")
+    else:
+        say(f"    unloaded TE p-p {run.tca.te_peak_to_peak_arcsec:.2f} arcsec (TCA only)")
+    kinds = (
+        "summary.json, cycle.pvd, vtk/, *.png" if run.cycle is not None else "summary.json, *.png"
+    )
+    say(f"wrote {len(paths)} files to {out}/ ({kinds}) in {time.perf_counter() - t_start:.1f} s")
+    return 0
+
+
+def _run_hertz(args: argparse.Namespace, case) -> int:
+    from fegear.convergence import observed_rate
+    from fegear.io.hertz_output import write_hertz_outputs
+    from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
+
+    if args.backend not in (None, "auto", "pardiso", "superlu"):
+        raise InputError("--backend", args.backend, "'auto', 'pardiso' or 'superlu'")
+    if args.fidelity not in (None, "fe", "hybrid"):
+        raise InputError("--fidelity", args.fidelity, "'fe' or 'hybrid' for the Hertz scene")
     level = case.level if args.level is None else args.level
     if not 0 <= level < len(CELLS_ACROSS_MINOR):
         raise InputError("--level", level, f"an integer in [0, {len(CELLS_ACROSS_MINOR) - 1}]")
@@ -135,6 +231,18 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except FegearError as exc:
         print(f"fegear: failed: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("fegear: interrupted (files already written are complete)", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001  (third-party failures, e.g. gmsh: one line, exit 1)
+        if os.environ.get("FEGEAR_DEBUG"):
+            raise
+        msg = " ".join(str(exc).split()) or type(exc).__name__
+        print(
+            f"fegear: failed: {type(exc).__name__}: {msg} (FEGEAR_DEBUG=1 for the traceback)",
+            file=sys.stderr,
+        )
         return 1
     return 1
 

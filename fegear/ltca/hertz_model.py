@@ -236,7 +236,7 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
                 semi_major_mm=float(a),
                 semi_minor_mm=float(bb),
                 n_active=0,
-                edge_contact=bool(pos.edge[i]) and f > 0.0,
+                edge_contact=bool(pos.edge[i]) and bool(f > 0.0),
                 contact_point=pos.points[i].copy(),
             )
         )

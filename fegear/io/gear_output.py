@@ -1,0 +1,542 @@
+"""Outputs of a gear-case run (DESIGN §10): ``summary.json``, VTK time series, PNGs.
+
+Files written to the output folder (each one atomically: complete or absent):
+
+- ``summary.json`` — inputs, per position (pinion angle, unloaded/loaded TE, pairs with force,
+  load share, p_max, patch axes, contact point in the fixed frame, edge flag), cycle values,
+  solver residuals, timings, versions, units. Keys other tools rely on:
+  ``cycle.te_pp_unloaded_arcsec``, ``cycle.te_pp_loaded_arcsec``,
+  ``cycle.contact_ratio_loaded``, ``cycle.p_max_MPa``, ``positions[i].pinion_angle_deg``,
+  ``positions[i].te_loaded_arcsec``, ``positions[i].pairs[j].load_share``,
+  ``positions[i].pairs[j].p_max_MPa``, ``positions[i].pairs[j].contact_point_mm``,
+  ``positions[i].pairs[j].edge_contact``. (Fidelity ``tca``: the loaded values are ``null``.)
+- ``vtk/pinion_<i>.vtu``, ``vtk/gear_<i>.vtu`` (fidelity ``fe``) — the sector of each member
+  in its assembled position at position ``i`` (fixed frame, mm; the gear at its unloaded
+  TCA-closed angle ``ratio·φ1 + TE_unloaded``, the elastic lag is not added), linear tets, with
+  point data ``displacement_mm`` (fixed-frame components of ``u = K⁻¹ P F``; *Warp By Vector*),
+  ``pressure_MPa`` (the pressure of the contact cell over each working-flank vertex, else 0) and
+  ``in_contact`` (1 on loaded flank vertices).
+- ``vtk/contact_cells_<i>.vtu`` — the contact cells of all pairs as quads on the pinion flank
+  (fixed frame) with cell data ``force_N``, ``pressure_MPa``, ``area_mm2`` (so that
+  ``Σ pressure·area = Σ force``), ``gap_mm``, ``active``, ``edge``, ``pair``,
+  ``pinion_tooth``, ``gear_tooth``: the exact solver output. A position without contact has an
+  empty file (VTK/ParaView/pyvista read it; meshio 5.3 cannot read an empty VTU).
+- ``cycle.pvd`` — the collection: time = pinion angle (deg), parts 0 pinion, 1 gear, 2 contact
+  cells; open it in ParaView and press play.
+- PNGs: ``te.png`` (unloaded and loaded TE), ``load_share.png``, ``p_max.png``,
+  ``bearing_pattern.png`` (union of the loaded cells on the pinion flank, coloured by the largest
+  pressure seen over the cycle). Fidelity ``tca``: ``te.png`` and ``bearing_pattern.png``
+  (unloaded, paint thickness).
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import math
+import platform
+from pathlib import Path
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from fegear.geometry.transforms import apply_points, apply_vectors
+from fegear.io.files import atomic_write, write_json
+from fegear.io.gear_run import GearRun
+
+__all__ = ["write_gear_outputs", "gear_summary", "write_pvd"]
+
+ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
+
+
+def _versions() -> dict[str, str]:
+    out = {"python": platform.python_version()}
+    for pkg in ("fegear", "numpy", "scipy", "scikit-fem", "gmsh", "meshio", "matplotlib",
+                "pypardiso"):  # fmt: skip
+        try:
+            out[pkg] = importlib.metadata.version(pkg)
+        except importlib.metadata.PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
+
+
+def _f(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+UNITS = {
+    "length": "mm",
+    "angle": "deg",
+    "te": "arcsec",
+    "force": "N",
+    "torque": "N·m (torque2_Nmm: N·mm)",
+    "pressure": "MPa",
+    "displacement (VTK)": "mm",
+}
+
+
+def _pair_row(q, k: int) -> dict[str, Any]:
+    loaded = q.force_N > 0.0
+    return {
+        "index": k,
+        "pinion_tooth": q.k,
+        "gear_tooth": q.j,
+        "force_N": q.force_N,
+        "torque_Nm": q.torque_Nmm / 1000.0,
+        "load_share": q.load_share,
+        "p_max_MPa": q.p_max_MPa,
+        "p_peak_MPa": q.p_peak_MPa,
+        "semi_major_mm": q.semi_major_mm,
+        "semi_minor_mm": q.semi_minor_mm,
+        "n_active_cells": q.n_active,
+        "edge_contact": q.edge_contact,
+        "in_contact": loaded,
+        "contact_point_mm": [float(x) for x in q.contact_point] if loaded else None,
+    }
+
+
+def _fe_positions(run: GearRun) -> list[dict[str, Any]]:
+    rows = []
+    for i, p in enumerate(run.cycle.positions):
+        s = p.solution
+        rows.append(
+            {
+                "index": i,
+                "pinion_angle_deg": math.degrees(p.phi1),
+                "gear_angle_deg": math.degrees(run.phi2[i]),
+                "te_unloaded_arcsec": p.te_unloaded_arcsec,
+                "te_loaded_arcsec": p.te_loaded_arcsec,
+                "te_loaded_urad": p.te_loaded_arcsec / ARCSEC_PER_RAD * 1e6,
+                "elastic_lag_arcsec": p.theta * ARCSEC_PER_RAD,
+                "n_pairs_in_contact": p.n_pairs_in_contact,
+                "total_force_N": float(s.force.sum()) if s.force.size else 0.0,
+                "p_max_MPa": p.p_max_MPa,
+                "pairs": [_pair_row(q, k) for k, q in enumerate(p.pairs)],
+                "solver": {
+                    "iterations": s.iterations,
+                    "equilibrium_residual": s.equilibrium_residual,
+                    "complementarity_residual": s.complementarity_residual,
+                    "max_penetration_mm": s.max_penetration,
+                    "min_active_force_N": s.min_active_force,
+                    "n_cells": int(s.force.size),
+                    "g_max_mm": p.g_max_mm,
+                },
+                "warnings": list(p.warnings),
+            }
+        )
+    return rows
+
+
+def _tca_positions(run: GearRun) -> list[dict[str, Any]]:
+    rows = []
+    for i, p in enumerate(run.tca.positions):
+        pairs = []
+        for k in range(p.pairs.shape[0]):
+            if not p.pair_valid[k]:
+                continue
+            contact = k == p.contact_pair
+            pairs.append(
+                {
+                    "index": k,
+                    "pinion_tooth": int(p.pairs[k, 0]),
+                    "gear_tooth": int(p.pairs[k, 1]),
+                    "in_contact": bool(contact),
+                    "backlash_mm": float(p.backlash_mm[k]),
+                    "load_share": None,
+                    "p_max_MPa": None,
+                    "edge_contact": bool(contact and p.edge[k] != ""),
+                    "edge": p.edge[k],
+                    "contact_point_mm": [float(x) for x in p.points[k]] if contact else None,
+                }
+            )
+        rows.append(
+            {
+                "index": i,
+                "pinion_angle_deg": math.degrees(p.phi1),
+                "gear_angle_deg": math.degrees(p.phi2),
+                "te_unloaded_arcsec": p.te_arcsec,
+                "te_loaded_arcsec": None,
+                "has_contact": bool(p.has_contact),
+                "pairs": pairs,
+            }
+        )
+    return rows
+
+
+def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]:
+    """The ``summary.json`` document of a gear run."""
+    case = run.case
+    doc: dict[str, Any] = {
+        "case": case.name,
+        "kind": case.kind,
+        "fidelity": case.fidelity,
+        "level": case.level if case.fidelity == "fe" else None,
+        "units": UNITS,
+        "conventions": {
+            "te": "TE = (phi2 - phi2_0) - (N1/N2)(phi1 - phi1_0) on member 2; negative: lag",
+            "frame": "fixed frame of fegear.assembly (contact points, VTK)",
+            "speed": "quasi-static model: speed does not enter",
+        },
+        "inputs": case.to_dict(),
+    }
+    if run.cycle is not None:
+        c = run.cycle
+        sols = [p.solution for p in c.positions]
+        doc["cycle"] = {
+            "n_positions": len(c.positions),
+            "torque2_Nm": c.torque2_Nmm / 1000.0,
+            "te_pp_unloaded_arcsec": c.te_pp_unloaded_arcsec,
+            "te_pp_loaded_arcsec": c.te_pp_loaded_arcsec,
+            "contact_ratio_loaded": c.contact_ratio_loaded,
+            "p_max_MPa": c.p_max_MPa,
+            "max_pairs_in_contact": int(c.n_in_contact.max()) if c.n_in_contact.size else 0,
+            "positions_without_contact": int(np.sum(c.n_in_contact == 0)),
+            "max_equilibrium_residual": max((s.equilibrium_residual for s in sols), default=0),
+            "max_complementarity_residual": max(
+                (s.complementarity_residual for s in sols), default=0.0
+            ),
+            "max_penetration_mm": max((s.max_penetration for s in sols), default=0.0),
+        }
+        doc["positions"] = _fe_positions(run)
+        doc["mesh"] = {
+            mf.name: {
+                "vertices": int(mf.points.shape[0]),
+                "tets": int(mf.tets.shape[0]),
+                "displacement_solver": mf.solver,
+            }
+            for mf in run.members
+        }
+        doc["timings_s"] = {**run.seconds, **{f"ltca.{k}": v for k, v in c.seconds.items()}}
+        warnings = sorted({w for p in c.positions for w in p.warnings})
+    else:
+        r = run.tca
+        doc["cycle"] = {
+            "n_positions": int(r.phi1.size),
+            "torque2_Nm": case.torque2_Nmm / 1000.0,
+            "te_pp_unloaded_arcsec": r.te_peak_to_peak_arcsec,
+            "te_pp_loaded_arcsec": None,
+            "contact_ratio_loaded": None,
+            "p_max_MPa": None,
+            "hertz_p0_max_MPa": _f(r.hertz_p0_MPa.max()) if r.hertz_p0_MPa.size else None,
+            "positions_without_contact": int(np.sum(~r.has_contact)),
+            "paint_thickness_mm": r.paint_mm,
+        }
+        doc["positions"] = _tca_positions(run)
+        doc["timings_s"] = dict(run.seconds)
+        warnings = []
+        if case.kind == "spiral_bevel":
+            warnings.append("unloaded TCA only: the spiral bevel loaded analysis is not available")
+    doc["warnings"] = warnings
+    doc["files"] = files or []
+    doc["versions"] = _versions()
+    return doc
+
+
+# --------------------------------------------------------------------------------------------
+# VTK
+# --------------------------------------------------------------------------------------------
+
+
+def _write_vtu(path: Path, mesh) -> Path:
+    import meshio
+
+    return atomic_write(path, lambda q: meshio.write(q, mesh, file_format="vtu"))
+
+
+def _cell_quads(cells) -> np.ndarray:
+    """``(n, 4, 3)`` corners of the cells from their 2 × 2 Gauss points (bilinear
+    extrapolation from the Gauss points at ``±1/√3`` to the corners at ``±1``)."""
+    q = cells.quad_points.reshape(-1, 2, 2, 3)
+    c = q.mean(axis=(1, 2))
+    order = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    return np.stack([c + math.sqrt(3.0) * (q[:, a, b] - c) for a, b in order], axis=1)
+
+
+def _contact_mesh(pos):
+    import meshio
+
+    if not pos.cells:
+        return meshio.Mesh(np.zeros((0, 3)), [("quad", np.zeros((0, 4), dtype=np.int64))])
+    corners = np.concatenate([_cell_quads(c) for c in pos.cells])
+    n = corners.shape[0]
+    data = {
+        "force_N": pos.solution.force,
+        "pressure_MPa": np.concatenate(pos.pressure),
+        "area_mm2": np.concatenate([c.area for c in pos.cells]),
+        "gap_mm": np.concatenate([c.gap for c in pos.cells]),
+        "active": pos.solution.active.astype(np.int32),
+        "edge": np.concatenate([c.boundary for c in pos.cells]).astype(np.int32),
+        "pair": np.concatenate([np.full(c.n, i, np.int32) for i, c in enumerate(pos.cells)]),
+        "pinion_tooth": np.concatenate([np.full(c.n, c.k, np.int32) for c in pos.cells]),
+        "gear_tooth": np.concatenate([np.full(c.n, c.j, np.int32) for c in pos.cells]),
+    }
+    return meshio.Mesh(
+        corners.reshape(-1, 3),
+        [("quad", np.arange(4 * n).reshape(n, 4))],
+        cell_data={k: [np.asarray(v)] for k, v in data.items()},
+    )
+
+
+def _node_pressure(mf, i: int, pos, X: np.ndarray) -> np.ndarray:
+    """Pressure of the contact cell over each working-flank vertex (fixed-frame points ``X``)."""
+    from scipy.spatial import cKDTree
+
+    p = np.zeros(X.shape[0])
+    if not pos.cells:
+        return p
+    gear = mf.name == "gear"
+    centers = np.concatenate(
+        [c.centers + (c.gap[:, None] * c.normals if gear else 0.0) for c in pos.cells]
+    )
+    half = np.concatenate([np.full(c.n, 0.5 * float(np.hypot(*c.cell_mm))) for c in pos.cells])
+    pres = np.concatenate(pos.pressure)
+    d, j = cKDTree(centers).query(X[mf.flank_nodes])
+    ok = d <= 1.05 * half[j]
+    p[mf.flank_nodes[ok]] = pres[j[ok]]
+    return p
+
+
+def _member_mesh(mf, i: int, pos):
+    import meshio
+
+    M = mf.placements[i]
+    X = apply_points(M, mf.points)
+    u = apply_vectors(M, mf.displacement[i])
+    p = _node_pressure(mf, i, pos, X)
+    return meshio.Mesh(
+        X,
+        [("tetra", mf.tets)],
+        point_data={
+            "displacement_mm": u,
+            "pressure_MPa": p,
+            "in_contact": (p > 0).astype(np.int32),
+        },
+    )
+
+
+def write_pvd(path: Path, entries: list[tuple[float, int, str]]) -> Path:
+    """A ParaView collection: ``entries`` of ``(time, part, relative file)``."""
+    lines = [
+        '<?xml version="1.0"?>',
+        '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+        "  <Collection>",
+    ]
+    for t, part, f in entries:
+        lines.append(
+            f'    <DataSet timestep="{t:.12g}" group="" part="{part}" file={quoteattr(f)}/>'
+        )
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    text = "\n".join(lines)
+    return atomic_write(path, lambda q: q.write_text(text, encoding="utf-8"))
+
+
+def _write_vtk(out: Path, run: GearRun) -> list[Path]:
+    vtk = out / "vtk"
+    paths, entries = [], []
+    for i, pos in enumerate(run.cycle.positions):
+        t = math.degrees(pos.phi1)
+        for part, mf in enumerate(run.members):
+            name = f"{mf.name}_{i:03d}.vtu"
+            paths.append(_write_vtu(vtk / name, _member_mesh(mf, i, pos)))
+            entries.append((t, part, f"vtk/{name}"))
+        name = f"contact_cells_{i:03d}.vtu"
+        paths.append(_write_vtu(vtk / name, _contact_mesh(pos)))
+        entries.append((t, len(run.members), f"vtk/{name}"))
+    paths.append(write_pvd(out / "cycle.pvd", entries))
+    return paths
+
+
+# --------------------------------------------------------------------------------------------
+# PNG
+# --------------------------------------------------------------------------------------------
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: Path) -> Path:
+    plt = _plt()
+    fig.tight_layout()
+    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
+    plt.close(fig)
+    return p
+
+
+def _title(run: GearRun) -> str:
+    c = run.case
+    return f"{c.name}: T2 {c.torque2_Nmm / 1000:.0f} N·m, {c.fidelity} level {c.level}"
+
+
+def _plot_te(out: Path, run: GearRun) -> Path:
+    plt = _plt()
+    c = run.cycle
+    deg = np.degrees(c.phi1)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    ax.plot(deg, c.te_unloaded_arcsec, "o-", ms=3, label="unloaded")
+    ax.plot(deg, c.te_loaded_arcsec, "s-", ms=3, label="loaded")
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("TE (arcsec)")
+    ax.set_title(
+        f"{_title(run)}\nTE p-p unloaded {c.te_pp_unloaded_arcsec:.2f}, "
+        f"loaded {c.te_pp_loaded_arcsec:.2f} arcsec",
+        fontsize=9,
+    )
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, out / "te.png")
+
+
+def _per_pair(run: GearRun, attr: str) -> dict[int, np.ndarray]:
+    """``{pinion tooth: (n,) values}`` (NaN where the pair is not modelled or not loaded)."""
+    c = run.cycle
+    teeth = sorted({q.k for p in c.positions for q in p.pairs})
+    out = {k: np.full(len(c.positions), np.nan) for k in teeth}
+    for i, p in enumerate(c.positions):
+        for q in p.pairs:
+            if q.force_N > 0:
+                out[q.k][i] = getattr(q, attr)
+    return out
+
+
+def _plot_load_share(out: Path, run: GearRun) -> Path:
+    plt = _plt()
+    deg = np.degrees(run.cycle.phi1)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for k, v in _per_pair(run, "load_share").items():
+        ax.plot(deg, np.nan_to_num(v), "o-", ms=3, label=f"pinion tooth {k:+d}")
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("load share (torque fraction)")
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_title(f"{_title(run)}\nloaded contact ratio {run.cycle.contact_ratio_loaded:.2f}",
+                 fontsize=9)  # fmt: skip
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, out / "load_share.png")
+
+
+def _plot_p_max(out: Path, run: GearRun) -> Path:
+    plt = _plt()
+    c = run.cycle
+    deg = np.degrees(c.phi1)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for k, v in _per_pair(run, "p_max_MPa").items():
+        ax.plot(deg, v, ".:", lw=1, label=f"pinion tooth {k:+d}")
+    ax.plot(deg, [p.p_max_MPa for p in c.positions], "k-", lw=1.5, label="position max")
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("largest cell pressure p_max (MPa)")
+    ax.set_title(f"{_title(run)}\ncycle p_max {c.p_max_MPa:.0f} MPa", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, out / "p_max.png")
+
+
+def _flank_bounds(run: GearRun):
+    m, side = run.pair.pinion, run.assembly.side1
+    try:
+        return m.boundaries(side)
+    except TypeError:
+        return m.boundaries()
+
+
+def _plot_pattern(out: Path, run: GearRun) -> Path:
+    """Union of the loaded cells on the pinion flank (tooth-local ``(u, v)``), coloured by the
+    largest pressure each point saw over the cycle; dots: force centroids (loaded path)."""
+    plt = _plt()
+    b = _flank_bounds(run)
+    nu, nv = 240, 240
+    us = np.linspace(b.u_fillet, b.u_tip, nu)
+    vs = np.linspace(b.v_start, b.v_end, nv)
+    P = np.zeros((nu, nv))
+    path = []
+    for pos in run.cycle.positions:
+        if not pos.cells:  # the hertz fidelity has no contact grid
+            continue
+        for c, p, q in zip(pos.cells, pos.pressure, pos.pairs, strict=True):
+            if q.force_N <= 0:
+                continue
+            du = _spacing(c.uv[:, 0], float(c.cell_mm[0]))
+            dv = _spacing(c.uv[:, 1], float(c.cell_mm[1]))
+            for (u, v), pv in zip(c.uv[p > 0], p[p > 0], strict=True):
+                iu = (us >= u - du / 2) & (us <= u + du / 2)
+                iv = (vs >= v - dv / 2) & (vs <= v + dv / 2)
+                blk = P[np.ix_(iu, iv)]
+                P[np.ix_(iu, iv)] = np.maximum(blk, pv)
+            w = p * c.area
+            path.append((w @ c.uv) / w.sum())
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    Pm = np.ma.masked_where(P <= 0, P)
+    im = ax.pcolormesh(vs, us, Pm, cmap="inferno", shading="nearest")
+    if path:
+        pa = np.array(path)
+        ax.plot(pa[:, 1], pa[:, 0], "c.", ms=4, label="force centroids")
+        ax.legend(fontsize=8, loc="upper right")
+    ax.add_patch(
+        _plt().Rectangle(
+            (b.v_start, b.u_fillet),
+            b.v_end - b.v_start,
+            b.u_tip - b.u_fillet,
+            fill=False,
+            ec="gray",
+            lw=1,
+        )  # fmt: skip
+    )
+    ax.set_xlim(b.v_start, b.v_end)
+    ax.set_ylim(b.u_fillet, b.u_tip)
+    ax.set_xlabel(getattr(b, "v_name", "v"))
+    ax.set_ylabel(getattr(b, "u_name", "u"))
+    ax.set_title(f"{_title(run)}\nloaded bearing pattern on the pinion flank", fontsize=9)
+    fig.colorbar(im, ax=ax, label="max pressure over the cycle (MPa)")
+    return _save(fig, out / "bearing_pattern.png")
+
+
+def _spacing(x: np.ndarray, cell_mm: float) -> float:
+    """Cell size along one flank coordinate: the spacing of the cell centres, or the cell size
+    in mm when the cells form a single row (the pinion flank coordinates of the involute
+    family, which carries the fe fidelity, are mm)."""
+    d = np.diff(np.unique(x))
+    d = d[d > 1e-9 * cell_mm]
+    return float(d.min()) if d.size else cell_mm
+
+
+def _tca_plots(out: Path, run: GearRun) -> list[Path]:
+    from fegear.tca.plots import plot_pattern, plot_te
+
+    r, name = run.tca, run.case.name
+    paths = [atomic_write(out / "te.png", lambda q: plot_te({name: r}, q,
+                          title=f"{name}: unloaded TE (TCA)"))]  # fmt: skip
+    paths.append(
+        atomic_write(
+            out / "bearing_pattern.png",
+            lambda q: plot_pattern(
+                r,
+                q,
+                _flank_bounds(run),
+                title=f"{name}: unloaded bearing pattern on the pinion flank",
+            ),
+        )  # fmt: skip
+    )
+    return paths
+
+
+def write_gear_outputs(out: Path, run: GearRun) -> list[Path]:
+    """Write every output of a gear run into ``out`` (atomically); returns the paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    if run.cycle is not None:
+        paths += _write_vtk(out, run)
+        paths += [_plot_te(out, run), _plot_load_share(out, run), _plot_p_max(out, run),
+                  _plot_pattern(out, run)]  # fmt: skip
+    else:
+        paths += _tca_plots(out, run)
+    files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]
+    # the summary last: its presence says the run is complete
+    paths.append(write_json(out / "summary.json", gear_summary(run, files)))
+    return paths

@@ -1,0 +1,437 @@
+"""Gear-pair cases and ``fegear run`` on them (issue 8; DESIGN §3, §10, §12).
+
+- Every case file in ``cases/`` loads and validates (fast); malformed gear cases end with one
+  line on stderr naming the problem and exit code 2, before any work.
+- End to end on the FZG spur pair at level 0 (default suite): summary keys, the ``.pvd`` read
+  back with pyvista (time steps, pressure field, total cell force equal to the solver's).
+- Smoke runs: the spiral bevel cases (unloaded TCA; the loaded analysis exits 1 with a clear
+  message) and the face-gear cases and the no-argument main job (``slow``: ~1 min cold each).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fegear.case import HertzCase, load_case
+from fegear.cli import main
+from fegear.io.gear_case import GearCase, parse_gear_case
+from fegear.io.seed import SEED_CASE_TOML, seed_case
+
+REPO = Path(__file__).resolve().parents[1]
+CASES = sorted((REPO / "cases").glob("*.toml"))
+FZG = REPO / "cases" / "fzg_spur.toml"
+FACE_GEAR = REPO / "cases" / "face_gear_nominal.toml"
+BEVEL = REPO / "cases" / "spiral_bevel_nominal.toml"
+
+
+def _one_line(err: str) -> str:
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+# --------------------------------------------------------------------------------------------
+# Every shipped case loads
+# --------------------------------------------------------------------------------------------
+
+
+def test_the_issue_cases_are_shipped():
+    names = {p.stem for p in CASES}
+    expected = {
+        "hertz_scene",
+        "fzg_spur",
+        "face_gear_nominal",
+        "face_gear_dgamma_minus",
+        "face_gear_dgamma_plus",
+        "face_gear_load_light",
+        "face_gear_load_moderate",
+        "face_gear_load_heavy",
+        "spiral_bevel_nominal",
+        "spiral_bevel_dE",
+        "spiral_bevel_dP",
+        "spiral_bevel_dG",
+        "spiral_bevel_dgamma",
+    }
+    assert expected <= names, expected - names
+
+
+@pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
+def test_every_case_loads_and_validates(path):
+    case = load_case(path)
+    assert case.name == path.stem  # one file per scenario, named as its file
+    if isinstance(case, HertzCase):
+        return
+    assert isinstance(case, GearCase)
+    assert case.torque2_Nmm > 0 and math.isfinite(case.torque2_Nmm)
+    assert case.fidelity in ("fe", "tca") and 0 <= case.level <= 4
+    if case.kind == "spiral_bevel":
+        assert case.fidelity == "tca"  # the loaded analysis waits for the gear sector mesh
+
+
+def test_seed_loads_and_errors_are_the_issue_values():
+    """Torques on the face gear 5e5, 3e6, 6e6 N·mm; Δγ = ∓0.02°; pinion torque 350.14 N·m."""
+    t2 = {
+        n: load_case(REPO / "cases" / f"face_gear_load_{n}.toml").torque2_Nmm
+        for n in ("light", "moderate", "heavy")
+    }
+    assert t2 == {"light": 5e5, "moderate": 3e6, "heavy": 6e6}
+    nominal = load_case(FACE_GEAR)
+    # pinion torque × N2/N1 (quasi-static, no friction): exact in binary to round-off
+    assert nominal.torque2_Nmm == pytest.approx(350.14e3 * 160 / 25, rel=1e-15)
+    for sign, name in ((-1, "minus"), (1, "plus")):
+        c = load_case(REPO / "cases" / f"face_gear_dgamma_{name}.toml")
+        assert c.errors.dgamma_deg == sign * 0.02
+        assert c.pair == nominal.pair and c.torque2_Nmm == nominal.torque2_Nmm
+    bevel = {n: load_case(REPO / "cases" / f"spiral_bevel_{n}.toml").errors
+             for n in ("dE", "dP", "dG", "dgamma")}  # fmt: skip
+    assert (bevel["dE"].dE_mm, bevel["dP"].dA1_mm, bevel["dG"].dA2_mm) == (0.05, 0.05, 0.05)
+    assert bevel["dgamma"].dgamma_deg == 0.02
+
+
+def test_built_in_seed_case_is_the_nominal_case_file():
+    from dataclasses import replace
+
+    seed, file = seed_case(), load_case(FACE_GEAR)
+    assert replace(seed, source=file.source) == file
+    assert tomllib.loads(SEED_CASE_TOML)["case"]["kind"] == "face_gear"
+
+
+# --------------------------------------------------------------------------------------------
+# Malformed gear cases: one line, exit 2, nothing written
+# --------------------------------------------------------------------------------------------
+
+FZG_TEXT = FZG.read_text(encoding="utf-8")
+FG_TEXT = FACE_GEAR.read_text(encoding="utf-8")
+BEVEL_TEXT = BEVEL.read_text(encoding="utf-8")
+
+
+def _edit(text: str, old: str, new: str) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+# (id, case text, words the one-line message must contain)
+BAD_GEAR_CASES = [
+    ("missing module", _edit(FZG_TEXT, "module_mm = 4.5\n", ""), ["pair.module_mm", "required"]),
+    ("missing teeth", _edit(FG_TEXT, "n_pinion = 25\n", ""), ["pair.n_pinion", "required"]),
+    ("module in inches", _edit(FZG_TEXT, "module_mm = 4.5", "module_in = 0.177"),
+     ["pair.module_in", "did you mean 'module_mm'"]),
+    ("torque in kNm", _edit(FZG_TEXT, "torque2_Nm = 200.0", "torque2_kNm = 0.2"),
+     ["load.torque2_kNm", "did you mean 'torque2_Nm'"]),
+    ("angle in rad", _edit(FG_TEXT, "dgamma_deg = 0.0", "dgamma_rad = 0.0"),
+     ["errors.dgamma_rad", "dgamma_deg"]),
+    ("negative teeth", _edit(FZG_TEXT, "[16, 24]", "[-16, 24]"), ["pair.teeth[0]", "-16", ">= 5"]),
+    ("negative face-gear teeth", _edit(FG_TEXT, "n_face_gear = 160", "n_face_gear = -160"),
+     ["pair.n_face_gear", "-160"]),
+    ("zero bevel teeth", _edit(BEVEL_TEXT, "n_gear = 36", "n_gear = 0"), ["pair.n_gear", "0"]),
+    ("teeth as float", _edit(FZG_TEXT, "[16, 24]", "[16.0, 24]"), ["pair.teeth[0]", "integer"]),
+    ("one tooth count", _edit(FZG_TEXT, "[16, 24]", "[16]"), ["pair.teeth", "two integers"]),
+    ("unknown key", _edit(FZG_TEXT, "[pair]\n", '[pair]\ncolour = "red"\n'), ["pair.colour"]),
+    ("key of another kind", _edit(FZG_TEXT, "da_mm = 0.0", "dgamma_deg = 0.0"),
+     ["errors.dgamma_deg", "kind 'spur'"]),
+    ("unknown section", FZG_TEXT + "\n[loads]\ntorque2_Nm = 1.0\n", ["loads", "[load]"]),
+    ("missing section", _edit(FZG_TEXT, "[load]\ntorque2_Nm = 200.0", ""), ["load", "required"]),
+    ("bad TOML", _edit(FZG_TEXT, "module_mm = 4.5", "module_mm = "), ["TOML", "line"]),
+    ("two torques",
+     _edit(FZG_TEXT, "torque2_Nm = 200.0", "torque2_Nm = 200.0\npinion_torque_Nm = 1.0"),
+     ["load", "exactly one"]),
+    ("no torque", _edit(FZG_TEXT, "torque2_Nm = 200.0", "speed_rpm = 100.0"), ["exactly one"]),
+    ("negative torque", _edit(FZG_TEXT, "torque2_Nm = 200.0", "torque2_Nm = -200.0"),
+     ["load.torque2_Nm", "-200", "> 0"]),
+    ("nan module", _edit(FZG_TEXT, "module_mm = 4.5", "module_mm = nan"),
+     ["pair.module_mm", "finite"]),
+    ("pressure angle", _edit(FZG_TEXT, "pressure_angle_deg = 20.0", "pressure_angle_deg = 50.0"),
+     ["pair.pressure_angle_deg", "50", "[10, 35]"]),
+    ("radii swapped", _edit(FG_TEXT, "outer_radius_mm = 560.0", "outer_radius_mm = 400.0"),
+     ["pair.outer_radius_mm", "inner_radius_mm"]),
+    ("level", _edit(FZG_TEXT, "level = 0", "level = 7"), ["analysis.level", "7", "[0, 4]"]),
+    ("fidelity", _edit(FZG_TEXT, 'fidelity = "fe"', 'fidelity = "hybrid"'),
+     ["analysis.fidelity", "hybrid"]),
+    ("positions", _edit(FZG_TEXT, "n_positions = 9", "n_positions = 1"),
+     ["analysis.n_positions", "[2, 400]"]),
+    ("nu", _edit(FZG_TEXT, "nu = 0.3", "nu = 0.5"), ["material.nu", "(-1, 0.5)"]),
+    ("unknown kind", _edit(FZG_TEXT, 'kind = "spur"', 'kind = "worm"'), ["case.kind", "worm"]),
+    ("shaper too small", _edit(FG_TEXT, "n_shaper = 27", "n_shaper = 25"),
+     ["pair.n_shaper", "n_pinion"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("text", "words"), [c[1:] for c in BAD_GEAR_CASES], ids=[c[0] for c in BAD_GEAR_CASES]
+)
+def test_malformed_gear_case_is_refused_with_one_line(tmp_path, capsys, text, words):
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    out = tmp_path / "out"
+    code = main(["run", str(path), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    line = _one_line(err)
+    assert line.startswith("fegear: error: "), line
+    for w in words:
+        assert w in line, f"{w!r} not in {line!r}"
+    assert not out.exists()  # refused before any work
+
+
+@pytest.mark.parametrize(
+    ("argv", "word"),
+    [
+        (["--level", "9"], "--level"),
+        (["--fidelity", "hybrid"], "--fidelity"),
+        (["--study", "0,1"], "--study"),
+    ],
+)
+def test_bad_command_line_values_for_a_gear_case(tmp_path, capsys, argv, word):
+    out = tmp_path / "out"
+    code = main(["run", str(FZG), "--out", str(out), *argv])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert word in _one_line(err)
+    assert not out.exists()
+
+
+def test_design_errors_name_the_case_key():
+    """A geometry refusal (undercut, pointed tooth, …) names the case-file key, not the
+    geometry's field; a pair given only in memory goes through the same schema."""
+    from fegear.errors import InputError
+    from fegear.io.gear_case import build_pair
+
+    data = tomllib.loads(_edit(FZG_TEXT, "profile_shift = [0.1817, 0.1715]",
+                               "profile_shift = [0.1817, 1.9]"))  # fmt: skip
+    case = parse_gear_case(data, "mem.toml")
+    # x2 = 1.9 makes the gear tooth pointed below its tip circle: the refusal names the member
+    # and the derived quantity (the tip radius is not a case key)
+    with pytest.raises(InputError, match=r"^pair \(gear tip_radius_mm, derived") as info:
+        build_pair(case)
+    assert "pointed" in str(info.value)
+    data = tomllib.loads(_edit(FG_TEXT, "n_shaper = 27", "n_shaper = 25"))
+    with pytest.raises(InputError, match=r"^pair\.n_shaper = 25 "):
+        build_pair(parse_gear_case(data, "mem.toml"))
+
+
+# --------------------------------------------------------------------------------------------
+# End to end: the FZG spur pair, fe level 0, 5 positions
+# --------------------------------------------------------------------------------------------
+
+N_FZG = 5
+
+
+@pytest.fixture(scope="module")
+def fzg_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fzg")
+    case = tmp_path_factory.mktemp("case") / "fzg.toml"
+    case.write_text(_edit(FZG_TEXT, "n_positions = 9", f"n_positions = {N_FZG}"), "utf-8")
+    code = main(["run", str(case), "--level", "0", "--out", str(out), "-q"])
+    return code, out
+
+
+def _get(doc, dotted: str):
+    for k in dotted.split("."):
+        if k.isdigit():
+            doc = doc[int(k)]
+        else:
+            assert k in doc, f"summary.json has no {dotted!r}"
+            doc = doc[k]
+    return doc
+
+
+def test_fzg_run_writes_the_summary_keys(fzg_run):
+    code, out = fzg_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["kind"] == "spur" and doc["fidelity"] == "fe" and doc["level"] == 0
+    for key in ("te_pp_unloaded_arcsec", "te_pp_loaded_arcsec", "contact_ratio_loaded",
+                "p_max_MPa"):  # fmt: skip
+        v = _get(doc, f"cycle.{key}")
+        assert isinstance(v, float) and math.isfinite(v), key
+    assert len(doc["positions"]) == N_FZG
+    # conjugate involute pair: no unloaded TE (invariant, to the TCA's round-off)
+    assert _get(doc, "cycle.te_pp_unloaded_arcsec") < 1e-6
+    # loaded: a lag (negative TE) at every position; one or two pairs (contact ratio 1.46)
+    assert 1.0 <= _get(doc, "cycle.contact_ratio_loaded") <= 2.0
+    for i, pos in enumerate(doc["positions"]):
+        assert _get(pos, "te_loaded_arcsec") < 0
+        assert -12.0 <= _get(pos, "pinion_angle_deg") < 12.0  # one cycle, 360/16 = 22.5 deg
+        shares = [_get(q, "load_share") for q in pos["pairs"]]
+        # torque balance is enforced by the solver: round-off
+        assert abs(sum(shares) - 1.0) < 1e-9, (i, shares)
+        assert pos["solver"]["equilibrium_residual"] < 1e-9
+        for q in pos["pairs"]:
+            assert isinstance(q["edge_contact"], bool)
+            assert q["p_max_MPa"] >= 0
+            if q["in_contact"]:
+                cp = np.array(q["contact_point_mm"])
+                # fixed frame: pinion axis +z at the origin; the contact lies between the base
+                # circle (r_b1 = 33.8 mm) and the tip circle (~41.6 mm) of the pinion
+                r = math.hypot(cp[0], cp[1])
+                assert 33.0 < r < 42.0 and abs(cp[2]) <= 7.0 + 1e-9, cp
+            else:
+                assert q["contact_point_mm"] is None
+    assert doc["versions"]["fegear"] and doc["timings_s"]["models"] > 0
+    assert doc["units"]["pressure"] == "MPa"
+    assert _get(doc, "cycle.p_max_MPa") == pytest.approx(
+        max(q["p_max_MPa"] for p in doc["positions"] for q in p["pairs"]), rel=1e-12
+    )
+
+
+def test_fzg_pvd_reads_back_with_pyvista(fzg_run):
+    import pyvista as pv
+
+    code, out = fzg_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    reader = pv.get_reader(str(out / "cycle.pvd"))
+    assert reader.number_time_points == N_FZG
+    angles = [p["pinion_angle_deg"] for p in doc["positions"]]
+    np.testing.assert_allclose(reader.time_values, angles, rtol=0, atol=1e-9)
+    for i, t in enumerate(reader.time_values):
+        reader.set_active_time_value(t)
+        blocks = reader.read()
+        assert blocks.n_blocks == 3  # pinion, gear, contact cells
+        pinion, gear, cells = blocks[0], blocks[1], blocks[2]
+        for member in (pinion, gear):
+            assert {"pressure_MPa", "displacement_mm", "in_contact"} <= set(member.point_data)
+            u = member.point_data["displacement_mm"]
+            assert u.shape == (member.n_points, 3) and np.all(np.isfinite(u))
+            assert member.point_data["pressure_MPa"].max() > 0  # the loaded flank shows
+        force = cells.cell_data["force_N"]
+        pressure = cells.cell_data["pressure_MPa"]
+        area = cells.cell_data["area_mm2"]
+        total = doc["positions"][i]["total_force_N"]
+        pairs = sum(q["force_N"] for q in doc["positions"][i]["pairs"])
+        # the cell field is the solver output written in float64: equal to round-off
+        assert abs(force.sum() - total) <= 1e-6 * total
+        assert abs((pressure * area).sum() - total) <= 1e-6 * total
+        assert abs(pairs - total) <= 1e-9 * total
+        assert pressure.max() == pytest.approx(doc["positions"][i]["p_max_MPa"], rel=1e-12)
+        # the flank-node pressures are cell pressures (no interpolation overshoot)
+        assert pinion.point_data["pressure_MPa"].max() <= pressure.max() * (1 + 1e-12)
+
+
+def test_fzg_members_are_placed_and_deformed_consistently(fzg_run):
+    """The loaded flank vertices of pinion and gear face each other (within an element of the
+    coarse mesh) and each member is pushed into its flank: the displacement at a loaded vertex
+    has a positive component against that member's outward flank direction."""
+    import meshio
+    from scipy.spatial import cKDTree
+
+    code, out = fzg_run
+    assert code == 0
+    for i in range(N_FZG):
+        pin = meshio.read(out / "vtk" / f"pinion_{i:03d}.vtu")
+        gear = meshio.read(out / "vtk" / f"gear_{i:03d}.vtu")
+        cells = meshio.read(out / "vtk" / f"contact_cells_{i:03d}.vtu")
+        centres = cells.points[cells.cells_dict["quad"]].mean(axis=1)
+        for m in (pin, gear):
+            loaded = m.points[m.point_data["pressure_MPa"] > 0]
+            # every loaded vertex sits over a contact cell: within a cell diagonal of one
+            # (cells ~2 mm at level 0)
+            assert cKDTree(centres).query(loaded)[0].max() < 4.0
+        # pinion: the pinion axis is +z at the origin; the gear centre is on +x
+        up = pin.point_data["displacement_mm"][pin.point_data["pressure_MPa"] > 0]
+        ug = gear.point_data["displacement_mm"][gear.point_data["pressure_MPa"] > 0]
+        # equal and opposite loads: the two members move apart along the line of action
+        assert np.dot(up.mean(axis=0), ug.mean(axis=0)) < 0
+
+
+def test_fzg_pngs_are_written(fzg_run):
+    code, out = fzg_run
+    assert code == 0
+    for name in ("te", "load_share", "p_max", "bearing_pattern"):
+        png = out / f"{name}.png"
+        assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+    assert not list(out.rglob(".*"))  # no temporary file left behind (atomic writes)
+
+
+# --------------------------------------------------------------------------------------------
+# Spiral bevel: unloaded TCA; the loaded analysis is refused with a clear message
+# --------------------------------------------------------------------------------------------
+
+
+def test_spiral_bevel_fe_is_refused_with_exit_1(tmp_path, capsys):
+    out = tmp_path / "out"
+    code = main(["run", str(BEVEL), "--fidelity", "fe", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1
+    line = [ln for ln in err.splitlines() if ln.startswith("fegear: ")][-1]
+    assert "spiral bevel" in line and "--fidelity tca" in line
+    assert not (out / "summary.json").exists()
+
+
+BEVEL_CASES = sorted((REPO / "cases").glob("spiral_bevel_*.toml"))
+
+
+@pytest.mark.parametrize("path", BEVEL_CASES, ids=[p.stem for p in BEVEL_CASES])
+def test_spiral_bevel_case_smoke(tmp_path, path):
+    """Unloaded TCA of each spiral bevel case at 5 positions (the machine-setting synthesis,
+    ~15 s, runs once per process for the shared blank data)."""
+    case = tmp_path / path.name
+    case.write_text(_edit(path.read_text("utf-8"), "n_positions = 13", "n_positions = 5"), "utf-8")
+    out = tmp_path / "out"
+    assert main(["run", str(case), "--out", str(out), "-q"]) == 0
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["fidelity"] == "tca"
+    assert 0 < doc["cycle"]["te_pp_unloaded_arcsec"] < 60  # designed parabola ~8 arcsec
+    assert doc["cycle"]["te_pp_loaded_arcsec"] is None
+    for name in ("te", "bearing_pattern"):
+        assert (out / f"{name}.png").is_file()
+
+
+# --------------------------------------------------------------------------------------------
+# Face gear (slow: ~1 min cold for meshing and operators, then cached within the session)
+# --------------------------------------------------------------------------------------------
+
+FACE_GEAR_CASES = sorted((REPO / "cases").glob("face_gear_*.toml"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", FACE_GEAR_CASES, ids=[p.stem for p in FACE_GEAR_CASES])
+def test_face_gear_case_smoke(tmp_path, path):
+    out = tmp_path / "out"
+    code = main(["run", str(path), "--level", "0", "--out", str(out), "-q"])
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    c = doc["cycle"]
+    assert c["max_equilibrium_residual"] < 1e-9
+    assert c["p_max_MPa"] > 0 and c["contact_ratio_loaded"] >= 1.0
+    assert c["positions_without_contact"] == 0
+
+
+@pytest.mark.slow
+def test_no_argument_main_job_writes_all_outputs(tmp_path, monkeypatch):
+    """``fegear run`` with no case: the seed face gear, fe level 0, 25 positions."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "-q"]) == 0
+    out = tmp_path / "out"
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["case"] == "face_gear_nominal" and doc["kind"] == "face_gear"
+    assert len(doc["positions"]) == 25
+    for f in doc["files"]:
+        assert (out / f).is_file(), f
+    import pyvista as pv
+
+    reader = pv.get_reader(str(out / "cycle.pvd"))
+    assert reader.number_time_points == 25
+    reader.set_active_time_value(reader.time_values[12])
+    cells = reader.read()[2]
+    total = doc["positions"][12]["total_force_N"]
+    assert abs(cells.cell_data["force_N"].sum() - total) <= 1e-6 * total
+
+
+def test_fzg_hertz_fidelity_runs_from_the_command_line(tmp_path):
+    out = tmp_path / "hertz"
+    assert main(["run", str(FZG), "--fidelity", "hertz", "--out", str(out), "-q"]) == 0
+    doc = json.loads((out / "summary.json").read_text())
+    cyc = doc["cycle"]
+    # one scalar torque equation solved to 1e-14: balance to round-off
+    assert cyc["max_equilibrium_residual"] < 1e-9
+    assert cyc["te_pp_loaded_arcsec"] > 0.0 and cyc["p_max_MPa"] > 0.0
+    for pos in doc["positions"]:
+        shares = [p["load_share"] for p in pos["pairs"]]
+        assert abs(sum(shares) - 1.0) < 1e-9  # the shares of one balanced torque
