@@ -1,7 +1,8 @@
 """Tooth-sector meshes (DESIGN §6): named groups, flank accuracy, volume, static convergence.
 
 Meshes are cached (``meshes/cache`` or ``$FEGEAR_CACHE``); a cold run meshes the coarsest levels
-only. The spiral bevel pair is designed once per session (~12 s).
+only. The default suite checks the FZG pinion and the face gear; the face-gear pinion and the
+spiral bevel pinion and gear run under ``-m slow`` (the bevel pair design alone takes ~10 s).
 """
 
 from __future__ import annotations
@@ -46,13 +47,18 @@ def bevel_pair():
     return SpiralBevelPair.design()
 
 
-# the spiral bevel GEAR is not supported yet (planar sections of its 3-tooth sector reach
-# 10 % past the heel, where the flank solve diverges): see docs/mesh/README.md
-MEMBERS = ["fzg_pinion", "face_gear", "face_gear_pinion", "bevel_pinion"]
+# every family at least in the slow suite; FZG pinion + face gear in the default one
+MEMBERS = [
+    "fzg_pinion",
+    "face_gear",
+    pytest.param("face_gear_pinion", marks=pytest.mark.slow),
+    pytest.param("bevel_pinion", marks=pytest.mark.slow),
+    pytest.param("bevel_gear", marks=pytest.mark.slow),
+]
 
 
 @pytest.fixture(scope="session", params=MEMBERS)
-def member(request, bevel_pair):
+def member(request):
     name = request.param
     if name == "fzg_pinion":
         return fzg_pinion()
@@ -60,7 +66,8 @@ def member(request, bevel_pair):
         return FaceGearMember(FaceGearDesign())
     if name == "face_gear_pinion":
         return face_gear_pinion()
-    return bevel_pair.pinion if name == "bevel_pinion" else bevel_pair.gear
+    pair = request.getfixturevalue("bevel_pair")  # designed only when a bevel member runs
+    return pair.pinion if name == "bevel_pinion" else pair.gear
 
 
 @pytest.fixture(scope="session")
@@ -115,10 +122,12 @@ def test_volume_against_section_integral(member, sector: SectorMesh):
     fr = sector_frame(member)
     ref = section_integral_volume(fr, 3)
     err = sector.volume() / ref - 1
-    # tolerance: linear tets chord curved faces (error O(h²/R): the bore gains volume, convex
-    # faces lose it; ~0.5 % at level 0); face gear / bevel add the difference between the CAD
-    # root blend (cubic) and the chord the estimate uses (< 0.5 %): 1.5 % in all.
-    assert abs(err) < 0.015, f"mesh volume {sector.volume():.1f} vs {ref:.1f}: {err:+.3%}"
+    # the estimate integrates the (φ, h) section of the same solid (exact flank points, the same
+    # cubic root blends for face gear / bevel) along the face, independently of CAD and mesh.
+    # Tolerance 1.2 %: what remains is linear tets chording curved faces, O(h²/R): the concave
+    # bore/base side gains volume, convex faces lose it; +0.3 … +0.9 % at level 0 (measured, all
+    # families), shrinking with refinement (see test_spur_volume_converges).
+    assert abs(err) < 0.012, f"mesh volume {sector.volume():.1f} vs {ref:.1f}: {err:+.3%}"
     log.info("%s: volume error %+.3f %%", member.name, 100 * err)
 
 
@@ -137,6 +146,17 @@ def test_spur_static_convergence():
     # with linear geometry give a noisy rate near 2)
     assert e12 < 0.03 * d[2], msg
     assert rate > 0.5, msg
+
+
+def test_spur_volume_converges():
+    """Mesh volume vs the section integral over levels 0-1-2 (meshes shared with the static
+    check): the chording error shrinks towards 0."""
+    m = fzg_pinion()
+    ref = section_integral_volume(sector_frame(m), 3)
+    err = np.array([sector_mesh(m, level=lv).volume() / ref - 1 for lv in (0, 1, 2)])
+    msg = f"volume errors {np.round(100 * err, 3)} %"
+    # tolerance: O(h²) chording, 0.9 % at level 0; level 2 (h/2) well below a third of it
+    assert abs(err[2]) < 0.3 * abs(err[0]) and abs(err[2]) < 0.003, msg
 
 
 def test_zone_and_inputs():

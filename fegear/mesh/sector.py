@@ -2,32 +2,43 @@
 
 Construction (gmsh, OpenCASCADE kernel; :mod:`fegear.mesh.sector_geometry` computes the curves):
 
-1. *Section wires* in parallel planes ``p · g = c`` (transverse planes for cylindrical gears,
-   planes normal to the radius of tooth 0 for the face gear, planes normal to the mean pitch
-   generatrix for bevel gears): exact flank sections interpolated by splines (``addSpline``
-   with exact end tangents, so flank/fillet joins are G1), tip and root lines on the exact
-   surfaces of revolution, straight cut lines through the middles of the two outer tooth
-   spaces, a bottom line below the rim.
+1. *Section wires* on the surfaces of constant face coordinate ``L`` (transverse planes
+   ``z = L`` for cylindrical gears, cylinders ``ρ = L`` for the face gear, back cones
+   ``L = const`` for bevel gears), so every tooth of the sector is cut at the same face
+   position however far it is turned (parallel planes cut the outer teeth of the 36-tooth
+   bevel gear's ±20° sector up to 10 % past the heel): exact flank points ``p(u, v = L)``
+   interpolated by splines (``addSpline`` with exact end tangents, so flank/fillet joins are
+   G1), tip and root lines on the exact surfaces of revolution, straight cut lines through the
+   middles of the two outer tooth spaces, a bottom line below the rim. The section curves and
+   their interpolation points are removed once lofted.
 2. ``addThruSections`` lofts them into one solid (one face per section edge; ruled for spur
    gears, whose flanks are straight along the face).
 3. The loft, built a little longer than the face and deeper than the rim, is intersected with
-   a solid of revolution (a revolved quadrilateral in the meridian plane) whose faces are the
-   exact face ends (planes ``z = ±b/2``; cylinders ``r = 471 / 560`` mm of the face gear;
-   toe/heel back cones of bevel gears) and the exact bore / blank base / rim-bottom cone.
+   a solid of revolution (a quadrilateral in the meridian half-plane φ = π revolved about z, so
+   its seam lies opposite the sector instead of splitting the centre tooth's faces into
+   slivers) whose faces are the exact face ends (planes ``z = ±b/2``; cylinders
+   ``r = 471 / 560`` mm of the face gear; toe/heel back cones of bevel gears) and the exact
+   bore / blank base / rim-bottom cone.
 4. Faces are named *geometrically*: envelope faces by their cone coordinates, loft faces by the
    nearest section edge (majority vote of a 5 × 5 parametric sample of the face).
 
 Fillets: the involute family models the generated trochoidal fillet (and the root circle
 between them). Face gear and spiral bevel geometry stop at the fillet limit; the sector closes
 each tooth space with a *root blend*: a cubic Hermite curve from the flank bottom (flank
-tangent) to the space middle on the root surface (tangent along the root), lofted along the
-face. It is not the generated fillet; it is there to carry the tooth-root compliance.
+tangent) to the space middle on the root surface (tangent along the root), tangents scaled to
+the chord (given to OCC as the equivalent Bézier, so the volume estimate can use the same curve),
+lofted along the face. It is not the generated fillet; it is there to carry the tooth-root
+compliance.
 
 Boundary conditions meant for this mesh (applied by the compliance stage): ``bore`` (involute
 and spiral bevel members: bore, or rim-bottom cone ``rim_modules · m`` below the root cone) or
 ``base`` (face gear: the blank bottom ``blank_thickness_mm`` below the root plane) fixed, and
 both sector cuts ``cut_left`` / ``cut_right`` fixed. Measured effect of the cut BC on the
 compliance of the centre tooth (FZG pinion, 3 teeth): see ``docs/mesh/README.md``.
+
+Quality: min SICN ≥ ``min_sicn``; attempts (2-D/3-D algorithm) Frontal-Delaunay/HXT,
+MeshAdapt/HXT, Frontal-Delaunay/Delaunay, MeshAdapt/Delaunay, each in a fresh gmsh session, else
+:class:`~fegear.errors.MeshError` listing every attempt.
 
 Sizes: one knob ``level`` (0 coarse … 4 fine). With ``m`` the module, the contact zone gets
 ``h_fine = FINE[level] m``, the fillets of the loaded teeth ``1.25 h_fine``, and the size grows
@@ -53,7 +64,13 @@ from numpy.typing import NDArray
 from ..errors import InputError, MeshError
 from ..geometry.surface import GeneratedMember, Side
 from .cache import cache_dir, cached_file, content_hash
-from .sector_geometry import SectorFrame, flank_distance, sections_edges, sector_frame
+from .sector_geometry import (
+    SectorFrame,
+    flank_distance,
+    hermite_points,
+    sections_edges,
+    sector_frame,
+)
 
 __all__ = [
     "FINE",
@@ -73,7 +90,7 @@ Array = NDArray[np.float64]
 FINE = (0.45, 0.32, 0.22, 0.16, 0.11)
 #: coarse (far-field) element size per level, in modules
 COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
-_VERSION = "sector-1"
+_VERSION = "sector-2"
 
 
 class FlankZone(NamedTuple):
@@ -174,49 +191,55 @@ class SectorMesh:
 
 
 # ------------------------------------------------------------------------------ construction
-def _add_curve(occ, e, t_start: int, t_end: int) -> int:
+def _add_curve(occ, e, t_start: int, t_end: int, aux: list[int]) -> int:
+    """Add the curve of section edge ``e`` between vertices ``t_start``, ``t_end``; the tags of
+    the auxiliary points (interpolation / control points) are appended to ``aux``."""
     if e.straight:
         return occ.addLine(t_start, t_end)
+    if len(e.points) == 2 and e.t0 is not None and e.t1 is not None:
+        # root blend: the cubic Hermite curve with tangents scaled to the chord ℓ, given
+        # explicitly as a Bézier (addSpline would rescale the tangents in its own way)
+        p0, p1 = e.points
+        ell = float(np.linalg.norm(p1 - p0))
+        c0 = occ.addPoint(*(p0 + ell / 3 * e.t0))
+        c1 = occ.addPoint(*(p1 - ell / 3 * e.t1))
+        aux += [c0, c1]
+        return occ.addBSpline([t_start, c0, c1, t_end], degree=3)
     mids = [occ.addPoint(*p) for p in e.points[1:-1]]
+    aux += mids
     tang: list[float] = []
     if e.t0 is not None and e.t1 is not None:
         tang = [*map(float, e.t0), *map(float, e.t1)]
     return occ.addSpline([t_start, *mids, t_end], tangents=tang)
 
 
-def _hermite(e, n: int = 7) -> Array:
-    """Approximate points of an edge curve for classification (interior)."""
-    if e.straight or e.t0 is None or len(e.points) > 2:
-        if len(e.points) > 2:
-            return e.points[1:-1]
-        return 0.5 * (e.points[:1] + e.points[1:])
-    p0, p1 = e.points
-    L = np.linalg.norm(p1 - p0)
-    t = np.linspace(0, 1, n + 2)[1:-1, None]
-    h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
-    h01, h11 = -2 * t**3 + 3 * t**2, t**3 - t**2
-    return h00 * p0 + h10 * L * e.t0 + h01 * p1 + h11 * L * e.t1
-
-
-def _label_clouds(fr: SectorFrame, n_teeth: int, n_planes: int = 13):
-    cs = np.linspace(*fr.c_range, n_planes)
-    pts, labs, cc = [], [], []
-    same = fr.family == "involute" and fr.n_sections == 2
-    allx = sections_edges(fr, n_teeth, cs[:1] if same else cs, nu=11)
-    for i, c in enumerate(cs):
+def _label_clouds(fr: SectorFrame, n_teeth: int, n_sections: int = 25):
+    """Labelled sample points of ``n_sections`` section wires spread over the loft span."""
+    Ls = np.linspace(*fr.L_range, n_sections)
+    pts, labs, ll = [], [], []
+    same = fr.family == "involute" and fr.n_sections == 2  # spur: sections are translates
+    allx = sections_edges(fr, n_teeth, Ls[:1] if same else Ls, nu=11)
+    for i, L in enumerate(Ls):
         edges = allx[0 if same else i]
         for e in edges:
-            q = _hermite(e)
+            q = hermite_points(e)
             if same:
-                q = q + (c - cs[0]) * fr.g
+                q = q + (L - Ls[0]) * fr.e_L
             pts.append(q)
             labs += [e.label] * len(q)
-            cc += [c] * len(q)
-    return np.vstack(pts), np.array(labs), np.array(cc), cs
+            ll += [L] * len(q)
+    return np.vstack(pts), np.array(labs), np.array(ll), Ls
 
 
 def _classify(gmsh, fr: SectorFrame, faces: list[int], n_teeth: int) -> dict[str, list[int]]:
-    P, labs, cc, cs = _label_clouds(fr, n_teeth)
+    """Name the faces of the trimmed solid geometrically.
+
+    Envelope faces by their cone coordinates (``L = L_start``, ``L = L_end``, ``h = bottom``);
+    loft faces by a majority vote of a 5 × 5 parametric sample: each sample point, moved along
+    the meridian to the nearest labelled section (same ``h`` and polar angle), takes the label
+    of the nearest section sample point.
+    """
+    P, labs, ll, Ls = _label_clouds(fr, n_teeth)
     tol = 1e-4 * max(1.0, fr.module)
     groups: dict[str, list[int]] = {}
     for tag in faces:
@@ -235,11 +258,11 @@ def _classify(gmsh, fr: SectorFrame, faces: list[int], n_teeth: int) -> dict[str
             name = fr.bottom_name
         else:
             votes: dict[str, int] = {}
-            for xi in x:
-                c = xi @ fr.g
-                cn = cs[np.argmin(np.abs(cs - c))]
-                sel = cc == cn
-                q = xi - (c - cn) * fr.g
+            phi = np.arctan2(x[:, 1], x[:, 0])
+            for Li, hi_, pi in zip(L, h, phi, strict=True):
+                Ln = Ls[np.argmin(np.abs(Ls - Li))]
+                sel = ll == Ln
+                q = fr.point(Ln, hi_, pi)
                 i = np.argmin(np.sum((P[sel] - q) ** 2, axis=1))
                 lab = labs[sel][i]
                 votes[lab] = votes.get(lab, 0) + 1
@@ -275,6 +298,46 @@ def _build(
     min_sicn: float,
     path: Path,
 ) -> dict[str, object]:
+    """Build and mesh the sector, writing ``path``; returns the diagnostics.
+
+    Attempts (2-D algorithm, 3-D algorithm), each in a fresh gmsh session (gmsh is not reliably
+    reusable after a failed ``generate``): Frontal-Delaunay surfaces and ``algorithm`` first;
+    on a failure or slivers (min SICN < ``min_sicn``) MeshAdapt surfaces, then the Delaunay
+    volume mesher.
+    """
+    attempts = list(dict.fromkeys([(6, algorithm), (1, algorithm), (6, 1), (1, 1)]))
+    failures = []
+    t0 = time.perf_counter()
+    for alg2, alg3 in attempts:
+        try:
+            diag = _attempt(fr, n_teeth, level, zone, alg2, alg3, path)
+        except _AttemptFailed as exc:
+            log.warning("sector mesh: %s", exc)
+            failures.append(str(exc))
+            continue
+        if diag["min_sicn"] >= min_sicn:
+            diag["attempts"] = len(failures) + 1
+            diag["total_s"] = time.perf_counter() - t0
+            return diag
+        msg = f"2D/3D algorithms {alg2}/{alg3}: min SICN {diag['min_sicn']:.3f} < {min_sicn}"
+        log.warning("sector mesh: %s", msg)
+        failures.append(msg)
+    raise MeshError(f"sector mesh quality: no acceptable mesh ({'; '.join(failures)})")
+
+
+class _AttemptFailed(Exception):
+    """gmsh failed to mesh with one pair of algorithms."""
+
+
+def _attempt(
+    fr: SectorFrame,
+    n_teeth: int,
+    level: int,
+    zone: Sequence[FlankZone],
+    alg2: int,
+    alg3: int,
+    path: Path,
+) -> dict[str, object]:
     import gmsh
 
     h_fine, h_coarse = mesh_sizes(fr.module, level)
@@ -284,19 +347,26 @@ def _build(
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 2)
-        gmsh.option.setNumber("General.NumThreads", 2)
+        gmsh.option.setNumber("General.NumThreads", 1)  # deterministic meshes (HXT)
         gmsh.model.add("sector")
         occ = gmsh.model.occ
-        wires = []
-        for edges in sections_edges(fr, n_teeth, np.linspace(*fr.c_range, fr.n_sections)):
+        wires: list[int] = []
+        aux: list[int] = []
+        section_curves: list[int] = []
+        for edges in sections_edges(fr, n_teeth, np.linspace(*fr.L_range, fr.n_sections)):
             starts = [occ.addPoint(*e.points[0]) for e in edges]
             curves = [
-                _add_curve(occ, e, starts[i], starts[(i + 1) % len(edges)])
+                _add_curve(occ, e, starts[i], starts[(i + 1) % len(edges)], aux)
                 for i, e in enumerate(edges)
             ]
             wires.append(occ.addWire(curves))
+            aux += starts
+            section_curves += curves
         loft = occ.addThruSections(wires, makeSolid=True, makeRuled=fr.n_sections == 2)
         loft_vol = [dt for dt in loft if dt[0] == 3]
+        # the section curves and their points are not part of the solid: left in the model,
+        # removeAllDuplicates would embed those touching it (split faces, slivers)
+        occ.remove([(1, c) for c in section_curves] + [(0, t) for t in aux], recursive=True)
         # envelope: revolved quadrilateral (L, h) -> (rho, z)
         hi = max(float(fr.tip(fr.L_start)), float(fr.tip(fr.L_end))) + 3 * fr.module
         corners = [
@@ -308,18 +378,31 @@ def _build(
         pts = []
         for L, h in corners:
             r, z = fr.rho_z(L, h)
-            pts.append(occ.addPoint(float(r), 0.0, float(z)))
+            # quadrilateral in the half-plane φ = π: the seam of the revolved envelope then lies
+            # opposite the sector (a seam through the teeth splits faces into slivers)
+            pts.append(occ.addPoint(-float(r), 0.0, float(z)))
         lines = [occ.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
         quad = occ.addPlaneSurface([occ.addCurveLoop(lines)])
         rev = occ.revolve([(2, quad)], 0, 0, 0, 0, 0, 1, 2 * math.pi)
         env = [dt for dt in rev if dt[0] == 3]
         out, _ = occ.intersect(loft_vol, env)
+        occ.synchronize()
+        log.debug("entities after trimming: %s", [len(gmsh.model.getEntities(d)) for d in range(4)])
         occ.removeAllDuplicates()
         occ.synchronize()
         vols = gmsh.model.getEntities(3)
         if len(vols) != 1:
             raise MeshError(f"sector solid has {len(vols)} volumes after trimming (expected 1)")
         vol = vols[0][1]
+        # drop what is not part of the solid (the envelope's generating quadrilateral)
+        bf = gmsh.model.getBoundary([(3, vol)], oriented=False)
+        bc = gmsh.model.getBoundary(bf, combined=False, oriented=False)
+        bp = gmsh.model.getBoundary(bc, combined=False, oriented=False)
+        keep = {(3, vol), *bf, *bc, *bp}
+        stray = [dt for d in (2, 1, 0) for dt in gmsh.model.getEntities(d) if dt not in keep]
+        if stray:
+            occ.remove(stray)
+            occ.synchronize()
         diag["cad_volume_mm3"] = occ.getMass(3, vol)
         faces = [t for _, t in gmsh.model.getBoundary([(3, vol)], oriented=False)]
         groups = _classify(gmsh, fr, faces, n_teeth)
@@ -369,33 +452,29 @@ def _build(
             "Mesh.MeshSizeFromCurvature": 0,
             "Mesh.MeshSizeMax": h_coarse,
             "Mesh.MeshSizeMin": 0.5 * h_fine,
-            "Mesh.Algorithm": 6,
             "Mesh.ElementOrder": 1,
             "Mesh.Optimize": 1,
         }.items():
             gmsh.option.setNumber(k, v)
         diag["zone_points"] = len(zp)
         tm = time.perf_counter()
-        for alg in dict.fromkeys([algorithm, 1]):
-            gmsh.option.setNumber("Mesh.Algorithm3D", alg)
-            gmsh.model.mesh.clear()
+        gmsh.option.setNumber("Mesh.Algorithm", alg2)
+        gmsh.option.setNumber("Mesh.Algorithm3D", alg3)
+        try:
             gmsh.model.mesh.generate(3)
-            tags, _ = gmsh.model.mesh.getElementsByType(4)
-            q = gmsh.model.mesh.getElementQualities(tags, "minSICN")
-            diag.update(
-                algorithm3d=alg,
-                min_sicn=float(q.min()),
-                sicn_p01=float(np.quantile(q, 0.01)),
-                n_tets=len(tags),
-            )
-            if q.min() >= min_sicn:
-                break
-            log.warning("min SICN %.3f < %.3f with 3D algorithm %d", q.min(), min_sicn, alg)
-        else:
-            raise MeshError(
-                f"sector mesh quality: min SICN {diag['min_sicn']:.3f} < {min_sicn} "
-                "with HXT and Delaunay"
-            )
+        except Exception as exc:  # gmsh raises a bare Exception
+            raise _AttemptFailed(f"2D/3D algorithms {alg2}/{alg3}: {exc}") from exc
+        tags, _ = gmsh.model.mesh.getElementsByType(4)
+        if len(tags) == 0:
+            raise _AttemptFailed(f"2D/3D algorithms {alg2}/{alg3}: no tetrahedra")
+        q = gmsh.model.mesh.getElementQualities(tags, "minSICN")
+        diag.update(
+            algorithm2d=alg2,
+            algorithm3d=alg3,
+            min_sicn=float(q.min()),
+            sicn_p01=float(np.quantile(q, 0.01)),
+            n_tets=len(tags),
+        )
         diag["mesh_s"] = time.perf_counter() - tm
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
         gmsh.option.setNumber("Mesh.SaveAll", 0)
