@@ -5,7 +5,7 @@ results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``). The ca
 what runs:
 
 - gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity fe`` or
-  ``hertz``) or the unloaded TCA (``--fidelity tca``; the only one for spiral bevel pairs for now);
+  ``hertz``) or the unloaded TCA (``--fidelity tca``);
 - ``hertz_scene``: the FE Hertz check (``--fidelity fe | hybrid``, ``--study``, ``--backend``).
 
 With no CASE it runs the built-in seed face-gear case (``cases/face_gear_nominal.toml``: N2 160,
@@ -79,7 +79,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
 
     from fegear.io.gear_case import build_pair
     from fegear.io.gear_output import write_gear_outputs
-    from fegear.io.gear_run import SPIRAL_BEVEL_FE, run_gear_case
+    from fegear.io.gear_run import run_gear_case
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
@@ -93,8 +93,6 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         raise InputError("--fidelity", fid, "'fe', 'hertz' or 'tca' for gear pairs")
     if not 0 <= lvl <= 4:
         raise InputError("--level", lvl, "an integer in [0, 4]")
-    if case.kind == "spiral_bevel" and fid == "fe":
-        raise FegearError(SPIRAL_BEVEL_FE)
     t_start = time.perf_counter()
     pair = build_pair(case)  # bad design data is refused here, before any output
     say(

@@ -15,9 +15,7 @@ Fidelities (DESIGN §9) available for gear pairs:
 - ``"tca"``: the rigid, unloaded TCA (:func:`fegear.tca.run_tca`): unloaded TE, contact path,
   unloaded bearing pattern. No FE, no loaded results.
 
-Spiral bevel pairs run ``"tca"`` only for now: their gear sector does not mesh yet, and asking
-for ``"fe"`` raises :class:`~fegear.errors.FegearError` (``fegear run`` exits with code 1 and says
-to use ``--fidelity tca``).
+The spiral bevel case files ask for ``"tca"`` (fast); ``fe`` and ``hertz`` run on them too.
 """
 
 from __future__ import annotations
@@ -32,21 +30,15 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from fegear.errors import FegearError, InputError
+from fegear.errors import InputError
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, GearCase, GearPair, build_pair
 
-__all__ = ["GearRun", "MemberField", "run_gear_case", "displacements", "SPIRAL_BEVEL_FE"]
+__all__ = ["GearRun", "MemberField", "run_gear_case", "displacements"]
 
 log = logging.getLogger(__name__)
 
 Array = NDArray[np.float64]
 Progress = Callable[[str, "int | None", "int | None"], None]
-
-SPIRAL_BEVEL_FE = (
-    "spiral bevel: the loaded (fe) analysis is not available yet (the gear sector does not mesh);"
-    " run the unloaded TCA with --fidelity tca"
-)
-
 
 @dataclass(frozen=True)
 class MemberField:
@@ -248,16 +240,12 @@ def run_gear_case(
     ------
     InputError
         Bad overrides or design data.
-    FegearError
-        A spiral bevel case asked for the ``fe`` fidelity (not available yet).
     """
     from fegear.ltca import LTCAOptions, build_models, run_ltca
     from fegear.tca import TCAOptions, reference_phase, run_tca
 
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
-    if case.kind == "spiral_bevel" and case.fidelity in ("fe", "hertz"):
-        raise FegearError(SPIRAL_BEVEL_FE)
     seconds: dict[str, float] = {}
     t0 = time.perf_counter()
     say("geometry", None, None)
