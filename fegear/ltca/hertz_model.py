@@ -125,6 +125,11 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
             hess = _hessian(tca, pos, i, step)
             if hess is not None:
                 break
+        if hess is None and i == pos.contact_pair and pos.ellipse is not None:
+            # at a flank edge the stencil leaves the flank: the TCA's ellipse at the contact
+            # point has the same relative curvature (A, B)
+            A_e, B_e = pos.ellipse.A, pos.ellipse.B
+            hess = (np.diag([2 * A_e, 2 * B_e]), float(_moment_arm(tca, pos, i)), None)
         if hess is None:
             if pos.backlash_mm[i] < 0.05:
                 warnings.append(f"pair ({g.k}, {g.j}): no curvature at its closest point: left out")
@@ -159,12 +164,19 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
             coeff = 3.84e-5 * (_E_STAR_STEEL / E_star) ** 0.9
             local = PairLaw("line", coeff, length, 0.0, B)
             d_ref = local.approach(torque2_Nmm / h_i)
-        c_i, warn = _lumped(tca, pos, gi, models, b_i + max(d_ref, 1e-4), E, nu)
+        c_i, warn = _lumped(tca, pos, gi, models, b_i + max(4.0 * d_ref, 0.02), E, nu)
         if warn:
             warnings.append(f"pair ({g.k}, {g.j}): {warn}")
         local.lumped = c_i
         out.append((g.k, g.j, i, b_i, h_i, local))
     return out, warnings
+
+
+def _moment_arm(tca, pos, i: int) -> float:
+    """Moment arm ``h`` of pair ``i`` at its closest point."""
+    u0, v0 = pos.pinion_uv[i]
+    _, _, _, h, _, _ = _separation(tca, pos.phi1, -pos.te_rad, i, np.array([u0]), np.array([v0]))
+    return float(h[0])
 
 
 def _lumped(tca, pos, gi, models, g_lim, E, nu):
@@ -179,7 +191,14 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu):
     if cells is None:
         return 0.0, "no FE cells at the closest point: lumped compliance 0"
     C = _solve_cells_compliance(tca, pos, models, [cells])
-    w = np.full(cells.n, 1.0 / cells.n)
+    # the unit load on the cells within 2.5 cells of the pair's closest point: a patch the FE
+    # resolves (a single cell would be under-resolved and the FE stiffer than the half-space)
+    i = int(np.flatnonzero((tca.pairs[:, 0] == cells.k) & (tca.pairs[:, 1] == cells.j))[0])
+    r = np.linalg.norm(cells.centers - pos.points[i], axis=1)
+    near = r <= 2.5 * float(np.max(cells.cell_mm))
+    if not near.any():
+        near = r <= r.min() + 1e-12
+    w = np.where(near, 1.0 / near.sum(), 0.0)
     hw = np.tile(0.5 * cells.cell_mm, (cells.n, 1))
     S = 2.0 * subsurface_influence(cells.local, 0.0, cells.local, hw, E, nu)
     c = float(w @ C @ w - w @ S @ w)
