@@ -164,7 +164,9 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
             coeff = 3.84e-5 * (_E_STAR_STEEL / E_star) ** 0.9
             local = PairLaw("line", coeff, length, 0.0, B)
             d_ref = local.approach(torque2_Nmm / h_i)
-        c_i, warn = _lumped(tca, pos, gi, models, b_i + max(4.0 * d_ref, 0.02), E, nu)
+        line = local.kind == "line"
+        g_lim = b_i + (max(d_ref, 1e-4) if line else max(4.0 * d_ref, 0.02))
+        c_i, warn = _lumped(tca, pos, gi, models, g_lim, E, nu, line=line)
         if warn:
             warnings.append(f"pair ({g.k}, {g.j}): {warn}")
         local.lumped = c_i
@@ -179,7 +181,7 @@ def _moment_arm(tca, pos, i: int) -> float:
     return float(h[0])
 
 
-def _lumped(tca, pos, gi, models, g_lim, E, nu):
+def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
     """``c = wᵀ C_FE w − wᵀ S w`` on the fe cells within separation ``g_lim`` (see module)."""
     from fegear.ltca.analysis import _solve_cells_compliance
 
@@ -191,11 +193,12 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu):
     if cells is None:
         return 0.0, "no FE cells at the closest point: lumped compliance 0"
     C = _solve_cells_compliance(tca, pos, models, [cells])
-    # the unit load on the cells within 2.5 cells of the pair's closest point: a patch the FE
-    # resolves (a single cell would be under-resolved and the FE stiffer than the half-space)
+    # the unit load: along the whole band for a line contact; for a point contact on the cells
+    # within 2.5 cells of the pair's closest point, a patch the FE resolves (a single coarse cell
+    # would be under-resolved and the FE stiffer than the half-space)
     i = int(np.flatnonzero((tca.pairs[:, 0] == cells.k) & (tca.pairs[:, 1] == cells.j))[0])
     r = np.linalg.norm(cells.centers - pos.points[i], axis=1)
-    near = r <= 2.5 * float(np.max(cells.cell_mm))
+    near = np.ones(cells.n, dtype=bool) if line else r <= 2.5 * float(np.max(cells.cell_mm))
     if not near.any():
         near = r <= r.min() + 1e-12
     w = np.where(near, 1.0 / near.sum(), 0.0)
