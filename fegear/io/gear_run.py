@@ -40,6 +40,7 @@ log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 Progress = Callable[[str, "int | None", "int | None"], None]
 
+
 @dataclass(frozen=True)
 class MemberField:
     """One member's sector and its displacement at every position (for the VTK files).

@@ -13,7 +13,7 @@ the pairs take load in the order of their separations as ``θ`` grows. Milliseco
 once the ``c_i`` are known.
 
 Local law: point contact (the separation's Hessian at the closest point gives ``A <= B`` in the
-tangent plane, :func:`fegear.hertz.hertz_law`: ``δ = c F^{2/3}``); when ``A < 1e-3 B`` the
+tangent plane, :func:`fegear.hertz.hertz_law`: ``δ = c F^{2/3}``); when ``A < 1e-6 B`` the
 contact is a line of length ``L`` (the extent along the flat direction of the band where the
 separation is within 20 µm of its minimum) and Palmgren's line-contact approach for steel,
 ``δ = 3.84e-5 F^0.9 / L^0.8`` (mm, N; Palmgren 1959, *Ball and Roller Bearing Engineering*;
@@ -140,7 +140,7 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
         b_i = float(pos.backlash_mm[i])
         if B <= 0.0:
             continue
-        if A >= 1e-3 * B:
+        if A >= 1e-6 * B:  # elongated point contacts (face gear: A/B ~ 1e-3) stay points
             law = hertz_law(A, B, E_star)
             local = PairLaw("point", law.compliance_coeff, 0.0, 0.0, B, law)
             d_ref = local.approach(torque2_Nmm / h_i)
