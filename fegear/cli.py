@@ -56,6 +56,30 @@ def _parser() -> argparse.ArgumentParser:
         "Hertz scene: fe | hybrid (coarse FE + half-space near field)",
     )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    s = sub.add_parser(
+        "sweep",
+        help="run several gear cases, or one case over a parameter grid, each in its own folder",
+    )
+    s.add_argument("case", nargs="+", help="gear case files (TOML)")
+    s.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="KEY=START:STOP:N",
+        help="a case-file key and its values (KEY=START:STOP:N or KEY=V1,V2,...), e.g. "
+        "errors.dgamma_deg=-0.04:0.04:5 or load.torque2_Nm=100:400:4; repeat for a product",
+    )
+    s.add_argument("--out", default="sweep", help="sweep folder (default: ./sweep)")
+    s.add_argument("--fidelity", help="fe | hertz | tca; overrides the cases")
+    s.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the cases")
+    s.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    s.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask distributed cluster (e.g. tcp://host:8786) instead of local processes",
+    )
+    s.add_argument("--nominal", help="reference item of the comparison (default: no errors)")
+    s.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     return p
 
 
@@ -214,6 +238,59 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
     return 0
 
 
+def _sweep(args: argparse.Namespace) -> int:
+    from fegear.sweep import build_items, require_dask, run_sweep
+
+    say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    t_start = time.perf_counter()
+    items = build_items(args.case, args.grid, fidelity=args.fidelity, level=args.level)
+    if args.workers < 1:
+        raise InputError("--workers", args.workers, "an integer >= 1")
+    names = [it.name for it in items]
+    if args.nominal is not None and args.nominal not in names:
+        raise InputError("--nominal", args.nominal, f"one of the item names {names}")
+    if args.scheduler:
+        require_dask()  # a one-line error before any output
+    where = (
+        f"Dask scheduler {args.scheduler}"
+        if args.scheduler
+        else f"{args.workers} local worker{'s' if args.workers > 1 else ''}"
+    )
+    grid = "".join(f" × {g}" for g in args.grid)
+    say(
+        f"fegear {__version__}: sweep of {len(items)} items ({', '.join(args.case)}{grid}), "
+        f"{where}, out {args.out}/"
+    )
+    width = len(str(len(items)))
+
+    def progress(r, k: int, n: int) -> None:
+        head = f"[{k:{width}d}/{n}] {r.name}"
+        if r.status == "skipped":
+            say(f"{head}  skipped (done)")
+        elif r.status == "failed":
+            say(f"{head}  failed: {r.error}")
+        else:
+            say(f"{head}  done in {r.seconds:.1f} s")
+
+    res = run_sweep(
+        items,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        nominal=args.nominal,
+        progress=progress,
+    )
+    counts = {s: sum(r.status == s for r in res.results.values()) for s in ("done", "skipped")}
+    say(
+        f"wrote {', '.join(p.name for p in res.files)} to {args.out}/: "
+        f"{counts['done']} computed, {counts['skipped']} skipped (done), {res.n_failed} failed "
+        f"in {time.perf_counter() - t_start:.1f} s"
+    )
+    if not args.quiet:
+        print((res.out / "comparison.md").read_text(encoding="utf-8"), end="")
+    return 1 if res.n_failed else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 2 bad input, 1 other failure)."""
     args = _parser().parse_args(argv)
@@ -224,6 +301,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "run":
             return _run(args)
+        if args.command == "sweep":
+            return _sweep(args)
     except InputError as exc:
         print(f"fegear: error: {exc}", file=sys.stderr)
         return 2

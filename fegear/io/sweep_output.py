@@ -1,0 +1,394 @@
+"""Outputs of a sweep (:mod:`fegear.sweep`): ``sweep.json``, ``comparison.md``, ``te_overlay.png``.
+
+Each item has its own folder ``<out>/<item>/`` with the outputs of ``fegear run``. The sweep
+outputs are written into ``<out>/`` (each atomically), from the items' ``summary.json``:
+
+- ``sweep.json`` — the items (name, base case, grid parameters, status, wall time, error) with
+  their key results (``te_pp_unloaded_arcsec``, ``te_pp_loaded_arcsec``,
+  ``contact_ratio_loaded``, ``p_max_MPa``, ``pattern_position_mm`` and its extent), and the
+  comparison against the nominal item. Rewritten after every item, so it tells the state of an
+  interrupted sweep too.
+- ``comparison.md`` — the comparison table (Markdown).
+- ``te_overlay.png`` — the TE curves of all finished items on one figure (unloaded and loaded).
+
+Pattern position (mm), the mean of the pairs' contact points over the cycle (weighted by the pair
+force when loaded; the unloaded TCA's contact points otherwise), measured along the face:
+
+- face gear: radius from the face-gear axis (fixed ``z`` axis): larger = toward the OUTER end;
+- spiral bevel: distance from the apex (the fixed-frame origin): larger = toward the outer end
+  (heel);
+- spur: axial position ``z`` from the face centre (no inner or outer end: toward ``+z``/``−z``).
+
+Comparison: ``te_ratio`` = TE peak-to-peak of the item / TE peak-to-peak of the nominal item
+(loaded when both are loaded, else unloaded; ``null`` when the nominal's TE is below
+:data:`TE_FLOOR_ARCSEC`, which a conjugate pair's unloaded TE is); ``pattern_shift_mm`` = item
+pattern position − nominal.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fegear import __version__
+from fegear.io.files import atomic_write, write_json
+
+__all__ = [
+    "TE_FLOOR_ARCSEC",
+    "key_results",
+    "comparison",
+    "write_sweep_json",
+    "write_sweep_outputs",
+]
+
+#: TE peak-to-peak below which a ratio against it is not meaningful (arcsec; round-off of the
+#: TCA of a conjugate pair is ~1e-3 arcsec).
+TE_FLOOR_ARCSEC = 0.01
+#: Pattern shifts smaller than this are reported as "none" (mm).
+SHIFT_FLOOR_MM = 1e-3
+
+_MEASURE = {
+    "face_gear": ("radius from the face-gear axis", "outer end", "inner end"),
+    "spiral_bevel": ("distance from the apex", "outer end (heel)", "inner end (toe)"),
+    "spur": ("axial position z from the face centre", "+z end", "-z end"),
+}
+
+
+def _finite(x: Any) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _measure(kind: str, p: np.ndarray) -> np.ndarray:
+    """``(n,)`` position along the face of contact points ``p`` ``(n, 3)`` (fixed frame, mm)."""
+    if kind == "face_gear":
+        return np.hypot(p[:, 0], p[:, 1])
+    if kind == "spiral_bevel":
+        return np.linalg.norm(p, axis=1)
+    return p[:, 2]
+
+
+def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """Key results of one run from its ``summary.json`` document.
+
+    Returns
+    -------
+    dict
+        ``te_pp_unloaded_arcsec``, ``te_pp_loaded_arcsec``, ``contact_ratio_loaded``,
+        ``p_max_MPa`` (``None`` where the fidelity has no loaded values),
+        ``pattern_position_mm`` (see the module docstring), ``pattern_extent_mm``
+        (``[min, max]`` of the contact points), ``pattern_measure``, ``pattern_weighting``.
+    """
+    c = doc["cycle"]
+    kind = doc["kind"]
+    pts, w = [], []
+    for pos in doc["positions"]:
+        for q in pos["pairs"]:
+            cp = q.get("contact_point_mm")
+            if cp is None:
+                continue
+            f = q.get("force_N")
+            if f is not None and f <= 0:
+                continue
+            pts.append(cp)
+            w.append(1.0 if f is None else float(f))
+    loaded = any(q.get("force_N") is not None for p in doc["positions"] for q in p["pairs"])
+    pos_mm = extent = None
+    if pts:
+        s = _measure(kind, np.asarray(pts, dtype=float))
+        wa = np.asarray(w)
+        pos_mm = float(np.sum(wa * s) / np.sum(wa))
+        extent = [float(s.min()), float(s.max())]
+    return {
+        "te_pp_unloaded_arcsec": _finite(c.get("te_pp_unloaded_arcsec")),
+        "te_pp_loaded_arcsec": _finite(c.get("te_pp_loaded_arcsec")),
+        "contact_ratio_loaded": _finite(c.get("contact_ratio_loaded")),
+        "p_max_MPa": _finite(c.get("p_max_MPa")),
+        "pattern_position_mm": pos_mm,
+        "pattern_extent_mm": extent,
+        "pattern_measure": _MEASURE.get(kind, _MEASURE["spur"])[0],
+        "pattern_weighting": "pair force" if loaded else "unloaded contact points",
+    }
+
+
+def _read_summary(folder: Path) -> dict[str, Any] | None:
+    try:
+        return json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+
+
+def _ratio(a: float | None, b: float | None) -> float | None:
+    if a is None or b is None or not b >= TE_FLOOR_ARCSEC:
+        return None
+    return a / b
+
+
+def _pick_nominal(items: Sequence, done: Mapping[str, dict], nominal: str | None) -> str | None:
+    if nominal is not None:
+        return nominal if nominal in done else None
+    ready = [it for it in items if it.name in done]
+    for it in ready:
+        if it.case.errors.is_zero:
+            return it.name
+    return ready[0].name if ready else None
+
+
+def comparison(
+    items: Sequence, keyres: Mapping[str, dict[str, Any]], nominal: str | None = None
+) -> dict[str, Any]:
+    """The comparison of the finished items against the nominal one.
+
+    Parameters
+    ----------
+    items
+        The :class:`~fegear.sweep.SweepItem` of the sweep, in order.
+    keyres
+        ``{item name: key_results(...)}`` of the finished items.
+    nominal
+        The reference item (default: the first finished item without installation errors, else
+        the first finished item).
+
+    Returns
+    -------
+    dict
+        ``{"nominal": name | None, "basis": "loaded" | "unloaded", "rows": [...]}``; a row per
+        finished item: ``item``, ``params``, ``te_ratio``, ``te_ratio_unloaded``,
+        ``te_ratio_loaded``, ``pattern_shift_mm``, ``pattern_shift_toward``.
+    """
+    nom = _pick_nominal(items, keyres, nominal)
+    if nom is None:
+        return {"nominal": None, "basis": None, "rows": []}
+    n = keyres[nom]
+    kind = next(it.case.kind for it in items if it.name == nom)
+    _, plus, minus = _MEASURE.get(kind, _MEASURE["spur"])
+    all_loaded = all(k["te_pp_loaded_arcsec"] is not None for k in keyres.values())
+    basis = "loaded" if all_loaded else "unloaded"
+    rows = []
+    for it in items:
+        k = keyres.get(it.name)
+        if k is None:
+            continue
+        r_un = _ratio(k["te_pp_unloaded_arcsec"], n["te_pp_unloaded_arcsec"])
+        r_lo = _ratio(k["te_pp_loaded_arcsec"], n["te_pp_loaded_arcsec"])
+        shift = None
+        if k["pattern_position_mm"] is not None and n["pattern_position_mm"] is not None:
+            shift = k["pattern_position_mm"] - n["pattern_position_mm"]
+        if it.name == nom:
+            r_un = 1.0 if r_un is not None else None
+            r_lo = 1.0 if r_lo is not None else None
+            shift = 0.0 if shift is not None else None
+        toward = None
+        if shift is not None:
+            toward = "none" if abs(shift) < SHIFT_FLOOR_MM else (plus if shift > 0 else minus)
+        rows.append(
+            {
+                "item": it.name,
+                "params": dict(it.params),
+                "te_ratio": r_lo if basis == "loaded" else r_un,
+                "te_ratio_unloaded": r_un,
+                "te_ratio_loaded": r_lo,
+                "pattern_shift_mm": shift,
+                "pattern_shift_toward": toward,
+            }
+        )
+    return {"nominal": nom, "basis": basis, "rows": rows}
+
+
+def _collect(out: Path, items: Sequence, results: Mapping) -> tuple[dict, dict]:
+    docs, keyres = {}, {}
+    for it in items:
+        r = results.get(it.name)
+        if r is None or r.status == "failed":
+            continue
+        doc = _read_summary(out / it.name)
+        if doc is not None:
+            docs[it.name] = doc
+            keyres[it.name] = key_results(doc)
+    return docs, keyres
+
+
+def _document(
+    out: Path, items: Sequence, results: Mapping, meta: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict, dict]:
+    docs, keyres = _collect(out, items, results)
+    rows = []
+    for it in items:
+        r = results.get(it.name)
+        rows.append(
+            {
+                "name": it.name,
+                "folder": it.name,
+                "base_case": it.base,
+                "source": it.case.source,
+                "kind": it.case.kind,
+                "fidelity": it.case.fidelity,
+                "level": it.case.level,
+                "params": dict(it.params),
+                "status": "pending" if r is None else r.status,
+                "seconds": None if r is None else r.seconds,
+                "error": None if r is None or not r.error else r.error,
+                "results": keyres.get(it.name),
+            }
+        )
+    params = sorted({k for it in items for k in it.params})
+    doc = {
+        "fegear": __version__,
+        "n_items": len(items),
+        "parameters": params,
+        "status": {
+            s: sum(row["status"] == s for row in rows)
+            for s in ("done", "skipped", "failed", "pending")
+        },
+        "workers": meta.get("workers"),
+        "scheduler": meta.get("scheduler"),
+        "units": {"te": "arcsec", "pressure": "MPa", "length": "mm"},
+        "items": rows,
+        "comparison": comparison(items, keyres, meta.get("nominal")),
+    }
+    return doc, docs, keyres
+
+
+def write_sweep_json(out: Path, items: Sequence, results: Mapping, meta: Mapping[str, Any]) -> Path:
+    """Write ``out/sweep.json`` (the current state of the sweep), atomically."""
+    doc, _, _ = _document(Path(out), items, results, meta)
+    return write_json(Path(out) / "sweep.json", doc)
+
+
+def _num(x: float | None, fmt: str) -> str:
+    return "—" if x is None else format(x, fmt)
+
+
+def _markdown(doc: dict[str, Any]) -> str:
+    cmp = doc["comparison"]
+    res = {row["name"]: row for row in doc["items"]}
+    lines = [
+        "# Sweep comparison",
+        "",
+        f"Nominal item: `{cmp['nominal']}`. TE ratio = TE peak-to-peak / nominal "
+        f"({cmp['basis']} TE). Pattern shift = mean contact position − nominal "
+        f"({_measure_text(doc)}).",
+        "",
+        "| item | status | TE p-p unloaded (arcsec) | TE p-p loaded (arcsec) | TE ratio "
+        "| contact ratio | p_max (MPa) | pattern position (mm) | shift (mm) | toward |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
+    ]
+    cmp_rows = {r["item"]: r for r in cmp["rows"]}
+    for name, row in res.items():
+        k = row["results"] or {}
+        c = cmp_rows.get(name, {})
+        label = f"**{name}**" if name == cmp["nominal"] else name
+        status = row["status"] + (f": {row['error']}" if row["error"] else "")
+        lines.append(
+            "| "
+            + " | ".join(
+                [
+                    label,
+                    status.replace("|", "/"),
+                    _num(k.get("te_pp_unloaded_arcsec"), ".3f"),
+                    _num(k.get("te_pp_loaded_arcsec"), ".3f"),
+                    _num(c.get("te_ratio"), ".3f"),
+                    _num(k.get("contact_ratio_loaded"), ".2f"),
+                    _num(k.get("p_max_MPa"), ".0f"),
+                    _num(k.get("pattern_position_mm"), ".3f"),
+                    _num(c.get("pattern_shift_mm"), "+.3f"),
+                    c.get("pattern_shift_toward") or "—",
+                ]
+            )
+            + " |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _measure_text(doc: dict[str, Any]) -> str:
+    for row in doc["items"]:
+        if row["results"]:
+            return row["results"]["pattern_measure"]
+    return "position along the face"
+
+
+def _label(it) -> str:
+    if it.params:
+        return ", ".join(f"{k.split('.', 1)[1]}={v:g}" if isinstance(v, float) else
+                         f"{k.split('.', 1)[1]}={v}" for k, v in it.params.items())  # fmt: skip
+    return it.name
+
+
+def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal: str | None):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ready = [it for it in items if it.name in docs]
+    loaded = any(docs[it.name]["cycle"].get("te_pp_loaded_arcsec") is not None for it in ready)
+    fig, axes = plt.subplots(1, 2 if loaded else 1, figsize=(12 if loaded else 6.5, 4.4),
+                             squeeze=False)  # fmt: skip
+    cmap = plt.get_cmap("viridis")
+    for i, it in enumerate(ready):
+        d = docs[it.name]
+        deg = [p["pinion_angle_deg"] for p in d["positions"]]
+        color = "k" if it.name == nominal else cmap(i / max(len(ready) - 1, 1))
+        style = {"color": color, "lw": 2.0 if it.name == nominal else 1.3, "ms": 3}
+        label = _label(it) + (" (nominal)" if it.name == nominal else "")
+        curves = [np.array([p["te_unloaded_arcsec"] for p in d["positions"]], dtype=float)]
+        if loaded:
+            curves.append(
+                np.array(
+                    [
+                        np.nan if p["te_loaded_arcsec"] is None else p["te_loaded_arcsec"]
+                        for p in d["positions"]
+                    ],
+                    dtype=float,
+                )  # fmt: skip
+            )
+        for j, te in enumerate(curves):
+            # the mean (a constant offset, large under shaft-angle errors) would hide the
+            # shape and amplitude: plotted about the cycle mean, the mean in the legend
+            mean = float(np.nanmean(te)) if np.any(np.isfinite(te)) else 0.0
+            axes[0, j].plot(deg, te - mean, "os"[j] + "-", label=f"{label} (mean {mean:+.2f})",
+                            **style)  # fmt: skip
+    titles = ["unloaded TE about its cycle mean", "loaded TE about its cycle mean"]
+    for j, ax in enumerate(axes[0]):
+        ax.set_xlabel("pinion angle φ1 (deg)")
+        ax.set_ylabel("TE − mean (arcsec)")
+        ax.set_title(titles[j], fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=1 if len(ready) <= 8 else 2, loc="best")
+    base = sorted({it.base for it in ready})
+    fig.suptitle(f"sweep of {', '.join(base)}: {len(ready)} items", fontsize=10)
+    fig.tight_layout()
+    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
+    plt.close(fig)
+    return p
+
+
+def write_sweep_outputs(
+    out: Path, items: Sequence, results: Mapping, meta: Mapping[str, Any]
+) -> list[Path]:
+    """Write ``sweep.json``, ``comparison.md`` and ``te_overlay.png`` into ``out`` (atomically).
+
+    Returns
+    -------
+    list of Path
+        The files written (no PNG when no item finished).
+    """
+    out = Path(out)
+    doc, docs, _ = _document(out, items, results, meta)
+    paths = []
+    if docs:
+        paths.append(
+            _plot_overlay(out / "te_overlay.png", items, docs, doc["comparison"]["nominal"])
+        )
+    text = _markdown(doc)
+    paths.append(atomic_write(out / "comparison.md", lambda p: p.write_text(text, "utf-8")))
+    doc["files"] = [p.name for p in paths] + ["sweep.json"]
+    paths.append(write_json(out / "sweep.json", doc))
+    return paths

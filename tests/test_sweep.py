@@ -1,0 +1,325 @@
+"""``fegear sweep`` (issue 8): grids, atomic items, resume after a kill, Dask, bad input.
+
+All on the FZG spur pair at fe level 0 with 3 positions (~2-4 s per item once the sector meshes
+and compliance operators are cached; the first item of the session builds them, ~10 s).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from fegear.cli import main
+from fegear.sweep import MARKER, build_items, parse_grid
+
+REPO = Path(__file__).resolve().parents[1]
+FZG = REPO / "cases" / "fzg_spur.toml"
+N_POS = 3
+
+
+def _one_line(err: str) -> str:
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+@pytest.fixture(scope="module")
+def fzg3(tmp_path_factory) -> Path:
+    """The FZG case with 3 positions (fast)."""
+    text = FZG.read_text(encoding="utf-8")
+    assert "n_positions = 9" in text
+    path = tmp_path_factory.mktemp("case") / "fzg3.toml"
+    path.write_text(text.replace("n_positions = 9", f"n_positions = {N_POS}"), "utf-8")
+    return path
+
+
+def _check_items(out: Path, names: list[str]) -> None:
+    """Every item folder is complete: summary.json parses, marker present; no tmp leftovers."""
+    for name in names:
+        doc = json.loads((out / name / "summary.json").read_text())
+        assert doc["case"] == name and len(doc["positions"]) == N_POS
+        assert json.loads((out / name / MARKER).read_text())["name"] == name
+        for f in doc["files"]:
+            assert (out / name / f).is_file(), (name, f)
+    assert not [p.name for p in out.glob(".*.tmp")]
+    assert not [p for p in out.rglob("*") if p.name.startswith(".") and p.name != ".sweep.lock"]
+
+
+# --------------------------------------------------------------------------------------------
+# A grid sweep: per-item outputs, sweep.json, overlay PNG, comparison table; re-run skips
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def grid_sweep(fzg3, tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep")
+    argv = ["sweep", str(fzg3), "--grid", "errors.f_sigma_beta_mm=-0.01:0.01:3",
+            "--out", str(out), "-q"]  # fmt: skip
+    t0 = time.perf_counter()
+    code = main(argv)
+    return code, out, argv, time.perf_counter() - t0
+
+
+def test_grid_sweep_writes_items_and_sweep_outputs(grid_sweep):
+    code, out, _, seconds = grid_sweep
+    assert code == 0
+    names = [f"fzg_spur__f_sigma_beta_mm={v}" for v in ("-0.01", "0", "0.01")]
+    _check_items(out, names)
+    doc = json.loads((out / "sweep.json").read_text())
+    assert [it["name"] for it in doc["items"]] == names
+    assert doc["parameters"] == ["errors.f_sigma_beta_mm"]
+    assert doc["status"] == {"done": 3, "skipped": 0, "failed": 0, "pending": 0}
+    for it, v in zip(doc["items"], (-0.01, 0.0, 0.01), strict=True):
+        assert it["params"] == {"errors.f_sigma_beta_mm": v}
+        r = it["results"]
+        for key in ("te_pp_unloaded_arcsec", "te_pp_loaded_arcsec", "contact_ratio_loaded",
+                    "p_max_MPa", "pattern_position_mm"):  # fmt: skip
+            assert isinstance(r[key], float) and math.isfinite(r[key]), (it["name"], key)
+        # the summary of the item folder is where the key results come from: exact copies
+        s = json.loads((out / it["name"] / "summary.json").read_text())["cycle"]
+        assert r["te_pp_loaded_arcsec"] == s["te_pp_loaded_arcsec"]
+    cmp = doc["comparison"]
+    assert cmp["nominal"] == names[1]  # the item without installation errors
+    assert cmp["basis"] == "loaded"
+    rows = {r["item"]: r for r in cmp["rows"]}
+    assert rows[names[1]]["te_ratio"] == 1.0 and rows[names[1]]["pattern_shift_mm"] == 0.0
+    for r in rows.values():
+        assert math.isfinite(r["te_ratio"]) and r["te_ratio"] > 0
+    # the axis tilted one way moves the pattern to one end of the face, the other way to the
+    # other end (physics sanity, sign only: coarse level 0)
+    lo, hi = rows[names[0]]["pattern_shift_mm"], rows[names[2]]["pattern_shift_mm"]
+    assert lo * hi < 0 and min(abs(lo), abs(hi)) > 0.1, (lo, hi)
+    assert {rows[names[0]]["pattern_shift_toward"], rows[names[2]]["pattern_shift_toward"]} == {
+        "+z end",
+        "-z end",
+    }
+    md = (out / "comparison.md").read_text()
+    assert md.count("\n| fzg_spur") + md.count("\n| **fzg_spur") == 3 and "TE ratio" in md
+    png = out / "te_overlay.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    print(f"grid sweep of 3 items: {seconds:.1f} s")
+
+
+def test_rerun_skips_finished_items(grid_sweep, capsys):
+    code, out, argv, _ = grid_sweep
+    assert code == 0
+    mtimes = {p: p.stat().st_mtime_ns for p in out.glob("*/summary.json")}
+    assert len(mtimes) == 3
+    capsys.readouterr()
+    assert main([a for a in argv if a != "-q"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("  skipped (done)\n") == 3, err
+    assert {p: p.stat().st_mtime_ns for p in out.glob("*/summary.json")} == mtimes
+    doc = json.loads((out / "sweep.json").read_text())
+    assert doc["status"]["skipped"] == 3
+    assert all(it["results"] is not None for it in doc["items"])
+
+
+# --------------------------------------------------------------------------------------------
+# Killed mid-run, then resumed
+# --------------------------------------------------------------------------------------------
+
+
+def test_killed_sweep_resumes_without_recomputing(fzg3, tmp_path):
+    out = tmp_path / "sweep"
+    argv = [sys.executable, "-m", "fegear.cli", "sweep", str(fzg3), "--out", str(out),
+            "--grid", "load.torque2_Nm=150:250:3"]  # fmt: skip
+    names = [f"fzg_spur__torque2_Nm={t}" for t in (150, 200, 250)]
+    proc = subprocess.Popen(
+        argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    first = out / names[0] / MARKER
+    t0 = time.monotonic()
+    try:
+        while not first.exists():
+            assert proc.poll() is None, proc.stderr.read().decode()
+            assert time.monotonic() - t0 < 60, "first item not done within 60 s"
+            time.sleep(0.05)
+        time.sleep(0.3)  # most likely inside the second item now (its .tmp folder on disk)
+    finally:
+        # kill the sweep and its worker process (its own process group) without warning
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        proc.stderr.close()
+    done_before = [n for n in names if (out / n / MARKER).exists()]
+    assert names[0] in done_before and len(done_before) < 3, done_before
+    mtimes = {n: (out / n / "summary.json").stat().st_mtime_ns for n in done_before}
+    # whatever is on disk now is either a complete item or hidden in a .tmp folder
+    for n in names:
+        if (out / n).exists():
+            json.loads((out / n / "summary.json").read_text())
+
+    res = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    for n in done_before:
+        assert f"{n}  skipped (done)" in res.stderr, res.stderr
+        assert (out / n / "summary.json").stat().st_mtime_ns == mtimes[n]
+    for n in set(names) - set(done_before):
+        assert f"{n}  done in" in res.stderr, res.stderr
+    _check_items(out, names)
+    doc = json.loads((out / "sweep.json").read_text())
+    assert [it["status"] for it in doc["items"]].count("skipped") == len(done_before)
+    assert doc["comparison"]["nominal"] == names[0]  # no errors anywhere: the first item
+    ratios = [r["te_ratio"] for r in doc["comparison"]["rows"]]
+    assert ratios[0] == 1.0 and all(math.isfinite(r) for r in ratios)
+
+
+def test_stale_or_foreign_item_folder_is_recomputed(fzg3, tmp_path, capsys):
+    """A folder without a matching marker is not trusted: it is recomputed and replaced; a
+    leftover tmp folder is removed."""
+    out = tmp_path / "sweep"
+    (out / "fzg_spur").mkdir(parents=True)
+    (out / "fzg_spur" / "summary.json").write_text("{half-writ")
+    (out / ".fzg_spur.deadbeef.tmp").mkdir()
+    (out / ".fzg_spur.deadbeef.tmp" / "te.png").write_bytes(b"\x89PN")
+    assert main(["sweep", str(fzg3), "--out", str(out)]) == 0
+    assert "fzg_spur  done in" in capsys.readouterr().err
+    _check_items(out, ["fzg_spur"])
+    # another level: another fingerprint, recomputed
+    (out / "fzg_spur" / "summary.json").touch()
+    t = (out / "fzg_spur" / "summary.json").stat().st_mtime_ns
+    assert main(["sweep", str(fzg3), "--out", str(out), "--fidelity", "hertz", "-q"]) == 0
+    assert (out / "fzg_spur" / "summary.json").stat().st_mtime_ns != t
+    assert json.loads((out / "fzg_spur" / "summary.json").read_text())["fidelity"] == "hertz"
+
+
+def test_failing_item_does_not_stop_the_others(fzg3, tmp_path, capsys):
+    """x2 = 1.9 passes the schema but makes a pointed gear tooth: that item fails (one line),
+    the other runs, exit code 1."""
+    out = tmp_path / "sweep"
+    text = fzg3.read_text()
+    bad = tmp_path / "pointed.toml"
+    bad.write_text(
+        text.replace("profile_shift = [0.1817, 0.1715]", "profile_shift = [0.1817, 1.9]")
+        .replace('name = "fzg_spur"', 'name = "pointed"'),
+        "utf-8",
+    )  # fmt: skip
+    assert main(["sweep", str(bad), str(fzg3), "--out", str(out), "--fidelity", "tca"]) == 1
+    err = capsys.readouterr().err
+    assert "pointed  failed: pair (gear tip_radius_mm" in err, err
+    assert "fzg_spur  done in" in err
+    doc = json.loads((out / "sweep.json").read_text())
+    status = {it["name"]: it["status"] for it in doc["items"]}
+    assert status == {"pointed": "failed", "fzg_spur": "done"}
+    assert not (out / "pointed").exists() and not list(out.glob(".*.tmp"))
+    assert "pointed | failed: pair (gear tip_radius_mm" in (out / "comparison.md").read_text()
+
+
+# --------------------------------------------------------------------------------------------
+# Dask
+# --------------------------------------------------------------------------------------------
+
+
+def test_dask_local_cluster(fzg3, tmp_path, capsys):
+    pytest.importorskip("dask")
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "sweep"
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        argv = ["sweep", str(fzg3), "--grid", "errors.da_mm=0,0.02", "--out", str(out),
+                "--scheduler", cluster.scheduler_address]  # fmt: skip
+        assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "Dask scheduler" in err and err.count("done in") == 2, err
+    names = ["fzg_spur__da_mm=0", "fzg_spur__da_mm=0.02"]
+    _check_items(out, names)
+    doc = json.loads((out / "sweep.json").read_text())
+    assert doc["scheduler"].startswith(("tcp://", "inproc://"))
+    rows = doc["comparison"]["rows"]
+    assert rows[0]["te_ratio"] == 1.0 and math.isfinite(rows[1]["te_ratio"])
+
+
+def test_scheduler_without_dask_is_one_line(fzg3, tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import fails as if not installed
+    out = tmp_path / "sweep"
+    code = main(["sweep", str(fzg3), "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"])
+    assert code == 1
+    line = _one_line(capsys.readouterr().err)
+    assert "Dask" in line and "pip install" in line, line
+
+
+# --------------------------------------------------------------------------------------------
+# Bad input: one line, exit 2, nothing run
+# --------------------------------------------------------------------------------------------
+
+BAD = [
+    ("no =", ["--grid", "errors.dgamma_deg"], ["--grid", "KEY=START:STOP:N"]),
+    ("no section", ["--grid", "da_mm=0:1:3"], ["--grid", "section.key"]),
+    ("unknown key", ["--grid", "errors.da_m=0:0.1:3"], ["errors.da_m", "did you mean 'da_mm'"]),
+    ("key of another kind", ["--grid", "errors.dgamma_deg=-0.04:0.04:5"],
+     ["errors.dgamma_deg", "kind 'spur'", "--grid errors.dgamma_deg"]),
+    ("unknown section", ["--grid", "loads.torque2_Nm=1:2:2"], ["loads", "[load]"]),
+    ("bad N", ["--grid", "errors.da_mm=0:0.1:x"], ["--grid", "N an integer"]),
+    ("N = 0", ["--grid", "errors.da_mm=0:0.1:0"], ["--grid", "N in [2, 1000]"]),
+    ("bad start", ["--grid", "errors.da_mm=a:0.1:3"], ["--grid", "START and STOP"]),
+    ("two colons", ["--grid", "errors.da_mm=0:0.1"], ["--grid", "three fields"]),
+    ("bad value", ["--grid", "load.torque2_Nm=-100:100:3"], ["load.torque2_Nm", "-100", "> 0"]),
+    ("string for a number", ["--grid", "pair.module_mm=big,small"],
+     ["pair.module_mm", "'big'", "a number"]),
+    ("float for an integer", ["--grid", "analysis.n_positions=3.5,4"],
+     ["analysis.n_positions", "integer"]),
+    ("case identity", ["--grid", "case.name=a,b"], ["--grid", "outside [case]"]),
+    ("same key twice", ["--grid", "errors.da_mm=0,1", "--grid", "errors.da_mm=2,3"],
+     ["--grid", "at most once"]),
+    ("level", ["--level", "9"], ["--level", "[0, 4]"]),
+    ("workers", ["--workers", "0"], ["--workers", ">= 1"]),
+    ("nominal", ["--nominal", "nope"], ["--nominal", "nope"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("argv", "words"), [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_bad_grid_is_one_line_exit_2(fzg3, tmp_path, capsys, argv, words):
+    out = tmp_path / "sweep"
+    code = main(["sweep", str(fzg3), "--out", str(out), *argv])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    line = _one_line(err)
+    assert line.startswith("fegear: error: "), line
+    for w in words:
+        assert w in line, f"{w!r} not in {line!r}"
+    if argv[0] != "--nominal":
+        assert not out.exists()  # refused before any work
+
+
+def test_bad_case_file_and_duplicate_names(fzg3, tmp_path, capsys):
+    assert main(["sweep", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "o")]) == 2
+    assert "missing.toml" in _one_line(capsys.readouterr().err)
+    assert main(["sweep", str(fzg3), str(fzg3), "--out", str(tmp_path / "o")]) == 2
+    assert "distinct case names" in _one_line(capsys.readouterr().err)
+    hertz = REPO / "cases" / "hertz_scene.toml"
+    assert main(["sweep", str(hertz), "--out", str(tmp_path / "o")]) == 2
+    assert "a gear pair" in _one_line(capsys.readouterr().err)
+    assert not (tmp_path / "o").exists()
+
+
+def test_grid_values_and_names(fzg3):
+    ax = parse_grid("errors.dgamma_deg=-0.04:0.04:5")
+    assert ax.values == (-0.04, -0.02, 0.0, 0.02, 0.04)  # tidy: no linspace round-off
+    assert parse_grid("load.torque2_Nm=100:400:4").values == (100, 200, 300, 400)
+    assert parse_grid("analysis.backend=superlu,auto").values == ("superlu", "auto")
+    items = build_items([fzg3], ["load.torque2_Nm=100:400:4", "errors.da_mm=0,0.01"], level=0)
+    assert len(items) == 8
+    assert items[1].name == "fzg_spur__torque2_Nm=100__da_mm=0.01"
+    assert items[1].case.torque2_Nmm == 100e3 and items[1].case.errors.da_mm == 0.01
+    assert items[1].case.name == items[1].name
+    assert len({it.fingerprint() for it in items}) == 8
+
+
+def test_one_sweep_per_folder(fzg3, tmp_path, capsys):
+    fcntl = pytest.importorskip("fcntl")
+    out = tmp_path / "sweep"
+    out.mkdir()
+    with open(out / ".sweep.lock", "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)  # another sweep holds the folder
+        assert main(["sweep", str(fzg3), "--out", str(out), "-q"]) == 1
+    assert "another sweep is writing" in _one_line(capsys.readouterr().err)
+    assert not (out / "fzg_spur").exists()
