@@ -286,7 +286,7 @@ def read_tet_mesh(path: Path) -> skfem.MeshTet:
     """Read a gmsh linear-tet mesh into scikit-fem with its named boundaries."""
     import meshio
 
-    m = meshio.read(path)
+    m = meshio.read(path, file_format="gmsh")  # no format guessing (meshio prints its misses)
     # gmsh also writes the nodes of geometric points that carry no element (the refinement
     # samples): keep only the nodes used by cells, renumbered.
     used = np.unique(np.concatenate([c.data.ravel() for c in m.cells]))

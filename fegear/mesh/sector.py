@@ -585,7 +585,7 @@ def load_sector_mesh(
     """Read a sector ``.msh`` (linear tets + named triangle groups) into a :class:`SectorMesh`."""
     import meshio
 
-    m = meshio.read(path)
+    m = meshio.read(path, file_format="gmsh")  # no format guessing (meshio prints its misses)
     tets = np.asarray(m.cells_dict["tetra"], dtype=np.int64)
     names = {int(v[0]): k for k, v in m.field_data.items() if int(v[1]) == 2}
     tri = np.asarray(m.cells_dict.get("triangle", np.zeros((0, 3))), dtype=np.int64)
