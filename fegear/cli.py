@@ -51,7 +51,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--fidelity",
-        help="gear pairs: fe (FE loaded TCA) | hertz (per-pair Hertz + lumped FE compliance) | "
+        help="gear pairs: fe (FE loaded TCA) | hybrid (FE + half-space near field, resolves the "
+        "patch) | hertz (per-pair Hertz + lumped FE compliance) | "
         "tca (unloaded, rigid); "
         "Hertz scene: fe | hybrid (coarse FE + half-space near field)",
     )
@@ -113,8 +114,8 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     fid = args.fidelity or case.fidelity
     lvl = case.level if args.level is None else args.level
-    if fid not in ("fe", "hertz", "tca"):
-        raise InputError("--fidelity", fid, "'fe', 'hertz' or 'tca' for gear pairs")
+    if fid not in ("fe", "hertz", "hybrid", "tca"):
+        raise InputError("--fidelity", fid, "'fe', 'hertz', 'hybrid' or 'tca' for gear pairs")
     if not 0 <= lvl <= 4:
         raise InputError("--level", lvl, "an integer in [0, 4]")
     t_start = time.perf_counter()

@@ -151,8 +151,8 @@ BAD_GEAR_CASES = [
     ("radii swapped", _edit(FG_TEXT, "outer_radius_mm = 560.0", "outer_radius_mm = 400.0"),
      ["pair.outer_radius_mm", "inner_radius_mm"]),
     ("level", _edit(FZG_TEXT, "level = 0", "level = 7"), ["analysis.level", "7", "[0, 4]"]),
-    ("fidelity", _edit(FZG_TEXT, 'fidelity = "fe"', 'fidelity = "hybrid"'),
-     ["analysis.fidelity", "hybrid"]),
+    ("fidelity", _edit(FZG_TEXT, 'fidelity = "fe"', 'fidelity = "exact"'),
+     ["analysis.fidelity", "exact"]),
     ("positions", _edit(FZG_TEXT, "n_positions = 9", "n_positions = 1"),
      ["analysis.n_positions", "[2, 400]"]),
     ("nu", _edit(FZG_TEXT, "nu = 0.3", "nu = 0.5"), ["material.nu", "(-1, 0.5)"]),
@@ -183,7 +183,7 @@ def test_malformed_gear_case_is_refused_with_one_line(tmp_path, capsys, text, wo
     ("argv", "word"),
     [
         (["--level", "9"], "--level"),
-        (["--fidelity", "hybrid"], "--fidelity"),
+        (["--fidelity", "exact"], "--fidelity"),
         (["--study", "0,1"], "--study"),
     ],
 )
@@ -436,3 +436,12 @@ def test_fzg_hertz_fidelity_runs_from_the_command_line(tmp_path):
     for pos in doc["positions"]:
         shares = [p["load_share"] for p in pos["pairs"]]
         assert abs(sum(shares) - 1.0) < 1e-9  # the shares of one balanced torque
+
+
+def test_fzg_hybrid_fidelity_runs_from_the_command_line(tmp_path):
+    out = tmp_path / "hybrid"
+    argv = ["run", str(FZG), "--fidelity", "hybrid", "--out", str(out), "-q"]
+    assert main(argv) == 0
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["cycle"]["max_equilibrium_residual"] < 1e-9  # the solver balances the torque
+    assert (out / "cycle.pvd").is_file()

@@ -15,8 +15,8 @@ Schema (``*`` = required)::
     [errors]    intersecting axes (face_gear, spiral_bevel): dE_mm, dA1_mm, dA2_mm, dgamma_deg
                 parallel axes (spur): da_mm, f_sigma_delta_mm, f_sigma_beta_mm, dA1_mm, dA2_mm
                 (all default 0; sign conventions in :mod:`fegear.assembly`)
-    [analysis]  fidelity ("fe" | "hertz" | "tca"), level (0..4), n_positions (>= 2), n_teeth (3..9),
-                backend ("auto" | "pardiso" | "superlu")
+    [analysis]  fidelity ("fe" | "hertz" | "hybrid" | "tca"), level (0..4), n_positions (>= 2),
+                n_teeth (3..9), backend ("auto" | "pardiso" | "superlu")
     [material]  E_MPa (> 0), nu (in (-1, 0.5))    — both members
 
 ``[pair]`` by kind:
@@ -59,7 +59,7 @@ __all__ = [
 
 GEAR_KINDS = ("face_gear", "spur", "spiral_bevel")
 #: Fidelities of the gear pairs available now (DESIGN §9): rigid TCA and pure FE.
-FIDELITIES = ("fe", "hertz", "tca")
+FIDELITIES = ("fe", "hertz", "hybrid", "tca")
 #: Sector mesh levels 0 … N_LEVELS − 1 (:data:`fegear.mesh.sector.FINE`).
 N_LEVELS = 5
 
@@ -468,7 +468,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     )
 
 
-_FIDELITY_NOTE = "hybrid is not available for gear pairs yet"
+_FIDELITY_NOTE = "fe, hertz, hybrid (loaded) or tca (unloaded)"
 
 
 # --------------------------------------------------------------------------------------------

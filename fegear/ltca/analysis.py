@@ -30,8 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from fegear.compliance import cross_compliance, find_tets, probe_operator
 from fegear.contact import solve_contact
 from fegear.errors import InputError
+from fegear.geometry.transforms import apply_points, apply_vectors, inverse
+from fegear.halfspace import subsurface_influence
 from fegear.ltca.grid import PairCells, pair_cells
 from fegear.ltca.model import (
     MemberModel,
@@ -40,7 +43,7 @@ from fegear.ltca.model import (
     member_load_operator,
 )
 from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
-from fegear.mesh.sector import sector_mesh
+from fegear.mesh.sector import FINE, sector_mesh
 from fegear.patch import measure_patch
 from fegear.tca import TCA, TCAOptions, reference_phase
 from fegear.tca.results import ARCSEC, PositionResult
@@ -76,8 +79,18 @@ class LTCAOptions:
     backend
         Sparse direct backend.
     fidelity
-        ``"fe"``: the contact grid with the FE compliance. ``"hertz"``: per-pair Hertz laws and
-        lumped FE compliance (:mod:`fegear.ltca.hertz_model`), milliseconds per position.
+        ``"fe"``: the contact grid with the FE compliance (cells one element wide).
+        ``"hertz"``: per-pair Hertz laws and lumped FE compliance (:mod:`fegear.ltca.hertz_model`).
+        ``"hybrid"`` (experimental): the FE read at a matching depth ``d`` below every cell plus
+        the closed-form half-space compression of the layer above it (Vijayakar 1991; the split
+        validated on the Hertz scene, :func:`fegear.scenes.hertz_scene.hybrid_compliance`),
+        inside each pair; plain ``PᵀK⁻¹P`` between pairs. The cells are refined below the
+        element size until ``n_across`` of them span each loaded patch.
+    n_across
+        ``hybrid``: cells wanted across each loaded patch in both flank directions.
+    depth_elements, depth_max_modules
+        ``hybrid``: ``d = min(depth_elements h, depth_max_modules m)`` (``h`` the fine element
+        size, ``m`` the module). Measured on the FZG pair: positive definite from d = 1.1 h.
     """
 
     n_positions: int = 25
@@ -90,10 +103,13 @@ class LTCAOptions:
     nu: float = 0.3
     backend: str = "auto"
     fidelity: str = "fe"
+    n_across: int = 8
+    depth_elements: float = 2.0
+    depth_max_modules: float = 0.35
 
     def __post_init__(self) -> None:
-        if self.fidelity not in ("fe", "hertz"):
-            raise InputError("fidelity", self.fidelity, "'fe' or 'hertz'")
+        if self.fidelity not in ("fe", "hertz", "hybrid"):
+            raise InputError("fidelity", self.fidelity, "'fe', 'hertz' or 'hybrid'")
 
 
 @dataclass(frozen=True)
@@ -104,20 +120,44 @@ class MemberModels:
     gear: MemberModel
     cell_mm: float
     seconds: float
+    fidelity: str = "fe"
+    depth_mm: float = 0.0
+    E: float = 206000.0
+    nu: float = 0.3
+    n_across: int = 8
 
 
 def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
     """Mesh both sectors and compute their compliance operators (cached)."""
     t0 = time.perf_counter()
-    models = []
-    for member, side in ((pinion, assembly.side1), (gear, assembly.side2)):
-        sm = sector_mesh(member, options.n_teeth, options.level)
-        models.append(
-            build_member_model(member.name, sm, side, options.E_MPa, options.nu, options.backend)
+    sectors = [sector_mesh(m, options.n_teeth, options.level) for m in (pinion, gear)]
+    h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
+    module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
+    depth = layer = 0.0
+    if options.fidelity == "hybrid":
+        depth = min(options.depth_elements * h, options.depth_max_modules * module)
+        layer = depth + 1.5 * h
+    models = [
+        build_member_model(
+            member.name, sm, side, options.E_MPa, options.nu, options.backend, layer_mm=layer
         )
-    h = max(float(m.sector.parameters["h_fine_mm"]) for m in models)
+        for member, side, sm in (
+            (pinion, assembly.side1, sectors[0]),
+            (gear, assembly.side2, sectors[1]),
+        )
+    ]
     cell = options.cell_mm if options.cell_mm is not None else h
-    return MemberModels(models[0], models[1], cell, time.perf_counter() - t0)
+    return MemberModels(
+        models[0],
+        models[1],
+        cell,
+        time.perf_counter() - t0,
+        fidelity=options.fidelity,
+        depth_mm=depth,
+        E=options.E_MPa,
+        nu=options.nu,
+        n_across=options.n_across,
+    )
 
 
 def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
@@ -181,6 +221,8 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
 
 def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
     """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
+    if models.fidelity == "hybrid":
+        return _hybrid_compliance(tca, pos, models, cells)
     asm = tca.asm
     M1 = asm.placement1(pos.phi1)
     M2 = asm.placement2(pos.phi2)
@@ -200,6 +242,92 @@ def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
         ]
     ).tocsr()
     return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
+
+
+def _hybrid_member(model, M, x, inward, P, depth: float) -> tuple[np.ndarray, np.ndarray]:
+    """FE part of the hybrid compliance of one member, ``sym(Qᵀ (K⁻¹)_cc P)``, ``Q`` reading the
+    displacement along the inward normal at ``x + d e``; a matching point that would leave the
+    tooth moves up by halving ``d`` (at most twice). Returns the matrix and the depths used."""
+    Minv = inverse(M)
+    e = apply_vectors(Minv, inward)
+    x0 = apply_points(Minv, x)
+    d = np.full(x0.shape[0], depth)
+    for _ in range(3):
+        tets, _ = find_tets(model.body.mesh, x0 + d[:, None] * e)
+        bad = tets < 0
+        if not bad.any():
+            break
+        d[bad] *= 0.5
+    Q = probe_operator(model.body, x0 + d[:, None] * e, e)
+    Cf = cross_compliance(model.op, Q, P)
+    return 0.5 * (Cf + Cf.T), d
+
+
+def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
+    """Hybrid compliance: inside each pair, FE at the matching depth + the half-space compression
+    of the layer ``[0, d]`` of each member (cells in intrinsic flank coordinates); between pairs
+    (different teeth, far apart) the plain surface coupling ``PᵀK⁻¹P``."""
+    asm = tca.asm
+    M1 = asm.placement1(pos.phi1)
+    M2 = asm.placement2(pos.phi2)
+    n1 = np.concatenate([c.normals for c in cells])
+    x1 = np.concatenate([c.centers for c in cells])
+    x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in cells])
+    P1 = sp.hstack(
+        [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
+    ).tocsr()
+    P2 = sp.hstack(
+        [
+            member_load_operator(
+                models.gear,
+                M2,
+                c.j,
+                c.quad_points + c.gap[:, None, None] * c.normals[:, None],
+                c.normals,
+            )
+            for c in cells
+        ]
+    ).tocsr()
+    C1, d1 = _hybrid_member(models.pinion, M1, x1, -n1, P1, models.depth_mm)
+    C2, d2 = _hybrid_member(models.gear, M2, x2, n1, P2, models.depth_mm)
+    C = member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
+    start = 0
+    for c in cells:
+        sl = slice(start, start + c.n)
+        S = C1[sl, sl] + C2[sl, sl]
+        s0 = subsurface_influence(c.local, 0.0, c.local, c.half_widths, models.E, models.nu)
+        for dd in (d1[sl], d2[sl]):
+            S += 0.5 * (s0 + s0.T)
+            for depth in np.unique(dd):
+                rows = np.flatnonzero(dd == depth)
+                sd = np.zeros((c.n, c.n))
+                sd[rows] = subsurface_influence(
+                    c.local[rows], float(depth), c.local, c.half_widths, models.E, models.nu
+                )
+                S -= 0.5 * (sd + sd.T)
+        C[sl, sl] = S
+        start += c.n
+    return C
+
+
+def _refined_sizes(cells, sol, cell, n_across):
+    """Cell sizes giving ``n_across`` cells across the loaded patches, or None if fine enough."""
+    start, ext_u, ext_v = 0, [], []
+    for c in cells:
+        act = sol.active[start : start + c.n]
+        start += c.n
+        if not act.any():
+            continue
+        uv = c.uv[act]
+        ext_u.append(np.unique(uv[:, 0]).size * c.cell_mm[0])
+        ext_v.append(np.unique(uv[:, 1]).size * c.cell_mm[1])
+    if not ext_u:
+        return None
+    su = min(cell[0], min(ext_u) / n_across)
+    sv = min(cell[1], min(ext_v) / n_across)
+    if su >= 0.99 * cell[0] and sv >= 0.99 * cell[1]:
+        return None
+    return (su, sv)
 
 
 def solve_position(
@@ -233,6 +361,18 @@ def solve_position(
         log.info("phi1 = %.4f: g_max raised to %.4g mm", pos.phi1, g_max)
     else:
         warnings.append(f"g_max did not settle (last {g_max:.3g} mm)")
+    # hybrid: refine the cells until every loaded patch has n_across cells across it in both
+    # flank directions; the zone shrinks to where the rigid approach theta h can close it.
+    for _ in range(3 if models.fidelity == "hybrid" else 0):
+        sizes = _refined_sizes(cells, sol, cell, models.n_across)
+        if sizes is None:
+            break
+        h_all = np.concatenate([c.h for c in cells])
+        g_ref = max(1.5 * sol.theta * float(h_all.max()), 1e-6)
+        cells2, sol2 = _solve_cells(tca, pos, models, torque2_Nmm, sizes, g_ref, warnings)
+        if sol2 is None or _excluded_violation(pos, g_ref, sol2.theta):
+            break
+        cells, sol, g_max, cell = cells2, sol2, g_ref, sizes
     # Per-pair results.
     loads, pressures = [], []
     start = 0

@@ -54,8 +54,10 @@ class PairCells:
     area
         ``(n,)`` mm².
     local
-        ``(n, 2)`` mm, cell centres in the flank tangent plane at the grid centre (for patch
-        measures: second moments, peak recovery).
+        ``(n, 2)`` mm, cell centres in intrinsic flank coordinates (arc lengths along the u and
+        v grid lines; for patch measures and the half-space near field).
+    half_widths
+        ``(n, 2)`` mm, half the cell sizes along u and v (from the exact flank tangents).
     cell_mm
         ``(2,)`` mm, cell sizes along ``u`` and ``v``.
     boundary
@@ -72,6 +74,7 @@ class PairCells:
     h: Array
     area: Array
     local: Array
+    half_widths: Array
     cell_mm: Array
     boundary: NDArray[np.bool_]
 
@@ -187,14 +190,17 @@ def pair_cells(
     ru = (q[:, 1, :, :] - q[:, 0, :, :]).mean(axis=1) / (du / math.sqrt(3.0))
     rv = (q[:, :, 1, :] - q[:, :, 0, :]).mean(axis=1) / (dv / math.sqrt(3.0))
     area = np.linalg.norm(np.cross(ru, rv), axis=-1) * du * dv
-    # Local tangent-plane coordinates at the grid centre.
-    c0 = X[keep].mean(axis=0)
-    e1 = ru.mean(axis=0)
-    e1 /= np.linalg.norm(e1)
-    nrm = N[keep].mean(axis=0)
-    e2 = np.cross(nrm, e1)
-    e2 /= np.linalg.norm(e2)
-    local = np.stack([(X[keep] - c0) @ e1, (X[keep] - c0) @ e2], -1)
+    # Intrinsic flank coordinates (mm): cumulative chord lengths along the u and v grid lines,
+    # so that the cells tile the plane without overlap even where the flank is strongly curved
+    # (a projection on one tangent plane would squeeze the far cells together).
+    su = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=-1).mean(1))])
+    sv = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=1), axis=-1).mean(0))])
+    IU, IV = np.meshgrid(np.arange(CU.shape[0]), np.arange(CU.shape[1]), indexing="ij")
+    lu_, lv_ = su[IU[keep]], sv[IV[keep]]
+    local = np.stack([lu_ - lu_.mean(), lv_ - lv_.mean()], -1)
+    half_widths = 0.5 * np.stack(
+        [np.linalg.norm(ru, axis=-1) * du, np.linalg.norm(rv, axis=-1) * dv], -1
+    )
     # Cells touching a working-flank boundary of the pinion or the gear.
     tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
     on_p = (
@@ -222,6 +228,7 @@ def pair_cells(
         h=h[keep],
         area=area,
         local=local,
+        half_widths=half_widths,
         cell_mm=np.array([du * lu, dv * lv]),
         boundary=(on_p | on_g)[keep],
     )

@@ -202,7 +202,7 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
     if not near.any():
         near = r <= r.min() + 1e-12
     w = np.where(near, 1.0 / near.sum(), 0.0)
-    hw = np.tile(0.5 * cells.cell_mm, (cells.n, 1))
+    hw = cells.half_widths
     S = 2.0 * subsurface_influence(cells.local, 0.0, cells.local, hw, E, nu)
     c = float(w @ C @ w - w @ S @ w)
     if c < 0.0:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 
 from fegear.compliance import CandidateOperator, body_compliance, candidate_operator, load_operator
 from fegear.errors import InputError
@@ -46,6 +47,9 @@ class MemberModel:
         ``(K⁻¹)_cc`` on the DOFs of the working flanks of the sector teeth.
     side
         Working flank side ("drive" or "coast").
+    layer_mm
+        Depth below the working flanks whose DOFs are in the operator too (the ``hybrid``
+        fidelity reads the FE displacement at a matching depth); 0 for ``fe`` and ``hertz``.
     """
 
     name: str
@@ -53,6 +57,7 @@ class MemberModel:
     body: ElasticBody
     op: CandidateOperator
     side: str
+    layer_mm: float = 0.0
 
     def boundary_of(self, tooth: int) -> str:
         """Boundary name of member tooth ``tooth``'s working flank in the sector."""
@@ -66,19 +71,33 @@ class MemberModel:
 
 
 def build_member_model(
-    name: str, sector: SectorMesh, side: str, E: float, nu: float, backend: str = "auto"
+    name: str,
+    sector: SectorMesh,
+    side: str,
+    E: float,
+    nu: float,
+    backend: str = "auto",
+    layer_mm: float = 0.0,
 ) -> MemberModel:
-    """Assemble a sector and compute ``(K⁻¹)_cc`` on all its working-flank DOFs."""
+    """Assemble a sector and compute ``(K⁻¹)_cc`` on all its working-flank DOFs (and, with
+    ``layer_mm > 0``, on every DOF within that distance of them)."""
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
     clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
     body = assemble_body(mesh, E, nu, clamped)
     flanks = [f"flank_{side}_{t}" for t in range(sector.n_teeth)]
     dofs = np.unique(np.concatenate([boundary_dofs(body.basis, f) for f in flanks]))
+    if layer_mm > 0.0:
+        locs = body.scalar_basis.doflocs.T  # (N, 3) P2 node positions
+        surf = np.unique(dofs // 3)
+        dist, _ = cKDTree(locs[surf]).query(locs, distance_upper_bound=layer_mm)
+        near = np.flatnonzero(np.isfinite(dist))
+        dofs = np.union1d(dofs, (3 * near[:, None] + np.arange(3)).ravel())
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
         "clamped": clamped,
         "flanks": flanks,
+        "layer_mm": layer_mm,
     }
     op = candidate_operator(body, dofs, backend=backend, cache_key=key)
     log.info(
@@ -89,7 +108,7 @@ def build_member_model(
         op.seconds,
         op.backend,
     )
-    return MemberModel(name=name, sector=sector, body=body, op=op, side=side)
+    return MemberModel(name=name, sector=sector, body=body, op=op, side=side, layer_mm=layer_mm)
 
 
 def member_load_operator(
