@@ -219,13 +219,9 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
     return cells, solve_contact(C, gap, torque2_Nmm, weights=h)
 
 
-def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
-    """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
-    if models.fidelity == "hybrid":
-        return _hybrid_compliance(tca, pos, models, cells)
-    asm = tca.asm
-    M1 = asm.placement1(pos.phi1)
-    M2 = asm.placement2(pos.phi2)
+def _load_operators(models, M1, M2, cells) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Consistent loads of all cells on both members: along ``−n1`` on the pinion flank, along
+    ``+n1`` at the same points moved across the gap onto the gear flank."""
     P1 = sp.hstack(
         [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
     ).tocsr()
@@ -241,6 +237,17 @@ def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
             for c in cells
         ]
     ).tocsr()
+    return P1, P2
+
+
+def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
+    """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
+    if models.fidelity == "hybrid":
+        return _hybrid_compliance(tca, pos, models, cells)
+    asm = tca.asm
+    M1 = asm.placement1(pos.phi1)
+    M2 = asm.placement2(pos.phi2)
+    P1, P2 = _load_operators(models, M1, M2, cells)
     return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
 
 
@@ -273,21 +280,7 @@ def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
     n1 = np.concatenate([c.normals for c in cells])
     x1 = np.concatenate([c.centers for c in cells])
     x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in cells])
-    P1 = sp.hstack(
-        [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
-    ).tocsr()
-    P2 = sp.hstack(
-        [
-            member_load_operator(
-                models.gear,
-                M2,
-                c.j,
-                c.quad_points + c.gap[:, None, None] * c.normals[:, None],
-                c.normals,
-            )
-            for c in cells
-        ]
-    ).tocsr()
+    P1, P2 = _load_operators(models, M1, M2, cells)
     C1, d1 = _hybrid_member(models.pinion, M1, x1, -n1, P1, models.depth_mm)
     C2, d2 = _hybrid_member(models.gear, M2, x2, n1, P2, models.depth_mm)
     C = member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)

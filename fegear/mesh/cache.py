@@ -15,11 +15,12 @@ import hashlib
 import json
 import logging
 import os
-import tempfile
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
+
+from fegear.io.files import atomic_write
 
 __all__ = ["cache_dir", "content_hash", "cached_file"]
 
@@ -85,17 +86,6 @@ def cached_file(
     if path.exists():
         log.info("cache hit %s/%s", kind, path.name)
         return path, True
-    fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=suffix, dir=folder)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp_path, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual mode
-    try:
-        build(tmp_path)
-        os.replace(tmp_path, path)
-    finally:
-        if tmp_path.exists():
-            tmp_path.unlink()
+    atomic_write(path, build)
     log.info("cache write %s/%s", kind, path.name)
     return path, False
