@@ -327,19 +327,30 @@ def candidate_operator(
     )
 
 
+def _rows(op: CandidateOperator, M: sp.spmatrix) -> np.ndarray:
+    """Positions in ``op.dofs`` of the candidate DOFs on which ``M`` has non-zero rows (sorted)."""
+    nz = np.flatnonzero(np.diff(sp.csr_matrix(M).indptr))
+    pos = np.minimum(np.searchsorted(op.dofs, nz), op.dofs.size - 1)
+    return pos[op.dofs[pos] == nz]
+
+
 def body_compliance(op: CandidateOperator, P: sp.csr_matrix) -> np.ndarray:
     """``C = P_c^T G P_c`` (n_cells × n_cells, mm/N), symmetrised.
 
     ``P`` may have non-zero rows outside the candidate DOFs only on clamped DOFs, which do not move
     (:func:`candidate_operator` is given the non-zero rows of ``P`` and keeps the free ones).
+    Only the candidate DOFs ``P`` touches enter the product (``G`` restricted to them), so the
+    cost is set by the cells, not by the size of the operator.
     """
-    Pd = P[op.dofs, :].toarray()
-    C = Pd.T @ (op.G @ Pd)
+    r = _rows(op, P)
+    Pd = sp.csr_matrix(P)[op.dofs[r], :].toarray()
+    C = Pd.T @ (op.G[np.ix_(r, r)] @ Pd)
     return 0.5 * (C + C.T)
 
 
 def cross_compliance(op: CandidateOperator, Q: sp.csr_matrix, P: sp.csr_matrix) -> np.ndarray:
     """``Q_c^T G P_c`` (n_probe × n_cells, mm/N): probe readings per unit cell force."""
-    Qd = Q[op.dofs, :].toarray()
-    Pd = P[op.dofs, :].toarray()
-    return Qd.T @ (op.G @ Pd)
+    rq, rp = _rows(op, Q), _rows(op, P)
+    Qd = sp.csr_matrix(Q)[op.dofs[rq], :].toarray()
+    Pd = sp.csr_matrix(P)[op.dofs[rp], :].toarray()
+    return Qd.T @ (op.G[np.ix_(rq, rp)] @ Pd)

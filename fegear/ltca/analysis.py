@@ -136,7 +136,7 @@ def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
     depth = layer = 0.0
     if options.fidelity == "hybrid":
         depth = min(options.depth_elements * h, options.depth_max_modules * module)
-        layer = depth + 1.5 * h
+        layer = depth
     models = [
         build_member_model(
             member.name, sm, side, options.E_MPa, options.nu, options.backend, layer_mm=layer
@@ -253,19 +253,29 @@ def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
 
 def _hybrid_member(model, M, x, inward, P, depth: float) -> tuple[np.ndarray, np.ndarray]:
     """FE part of the hybrid compliance of one member, ``sym(Qᵀ (K⁻¹)_cc P)``, ``Q`` reading the
-    displacement along the inward normal at ``x + d e``; a matching point that would leave the
-    tooth moves up by halving ``d`` (at most twice). Returns the matrix and the depths used."""
+    displacement along the inward normal at ``x + d e``. A matching point that would leave the
+    tooth, or fall in a tetrahedron outside the operator's layer, moves up by halving ``d``; a
+    cell whose point is still outside after three halvings (a cell overhanging the flank edge)
+    reads the FE at the surface, through its own load column (``d = 0``: no layer correction).
+    Returns the matrix and the depths used."""
     Minv = inverse(M)
     e = apply_vectors(Minv, inward)
     x0 = apply_points(Minv, x)
     d = np.full(x0.shape[0], depth)
-    for _ in range(3):
+    for _ in range(4):
         tets, _ = find_tets(model.body.mesh, x0 + d[:, None] * e)
         bad = tets < 0
+        bad[~bad] = ~model.layer_tets[tets[~bad]]
         if not bad.any():
             break
         d[bad] *= 0.5
-    Q = probe_operator(model.body, x0 + d[:, None] * e, e)
+    good = np.flatnonzero(~bad)
+    Q = probe_operator(model.body, x0[good] + d[good, None] * e[good], e[good])
+    if bad.any():
+        d[bad] = 0.0
+        log.debug("%s: %d hybrid cells read at the surface", model.name, int(bad.sum()))
+        order = np.concatenate([good, np.flatnonzero(bad)])
+        Q = sp.hstack([Q, sp.csc_matrix(P)[:, bad]]).tocsc()[:, np.argsort(order)]
     Cf = cross_compliance(model.op, Q, P)
     return 0.5 * (Cf + Cf.T), d
 

@@ -18,9 +18,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
-from fegear.compliance import CandidateOperator, body_compliance, candidate_operator, load_operator
+from fegear.compliance import (
+    CandidateOperator,
+    body_compliance,
+    candidate_operator,
+    find_tets,
+    load_operator,
+)
 from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body, boundary_dofs
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
@@ -50,6 +55,8 @@ class MemberModel:
     layer_mm
         Depth below the working flanks whose DOFs are in the operator too (the ``hybrid``
         fidelity reads the FE displacement at a matching depth); 0 for ``fe`` and ``hertz``.
+    layer_tets
+        ``(n_tets,)`` bool, the tetrahedra whose DOFs are all in ``op`` (the layer), or None.
     """
 
     name: str
@@ -58,6 +65,7 @@ class MemberModel:
     op: CandidateOperator
     side: str
     layer_mm: float = 0.0
+    layer_tets: np.ndarray | None = None
 
     def boundary_of(self, tooth: int) -> str:
         """Boundary name of member tooth ``tooth``'s working flank in the sector."""
@@ -80,19 +88,17 @@ def build_member_model(
     layer_mm: float = 0.0,
 ) -> MemberModel:
     """Assemble a sector and compute ``(K⁻¹)_cc`` on all its working-flank DOFs (and, with
-    ``layer_mm > 0``, on every DOF within that distance of them)."""
+    ``layer_mm > 0``, on the DOFs of the tetrahedra down to that depth below them)."""
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
     clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
     body = assemble_body(mesh, E, nu, clamped)
     flanks = [f"flank_{side}_{t}" for t in range(sector.n_teeth)]
     dofs = np.unique(np.concatenate([boundary_dofs(body.basis, f) for f in flanks]))
+    layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
     if layer_mm > 0.0:
-        locs = body.scalar_basis.doflocs.T  # (N, 3) P2 node positions
-        surf = np.unique(dofs // 3)
-        dist, _ = cKDTree(locs[surf]).query(locs, distance_upper_bound=layer_mm)
-        near = np.flatnonzero(np.isfinite(dist))
-        dofs = np.union1d(dofs, (3 * near[:, None] + np.arange(3)).ravel())
+        layer_tets[_layer_tets(mesh, flanks, layer_mm)] = True
+        dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
         "clamped": clamped,
@@ -108,7 +114,61 @@ def build_member_model(
         op.seconds,
         op.backend,
     )
-    return MemberModel(name=name, sector=sector, body=body, op=op, side=side, layer_mm=layer_mm)
+    return MemberModel(
+        name=name,
+        sector=sector,
+        body=body,
+        op=op,
+        side=side,
+        layer_mm=layer_mm,
+        layer_tets=layer_tets,
+    )
+
+
+def _layer_tets(mesh, flanks: list[str], depth: float) -> np.ndarray:
+    """Tetrahedra met by the points below the flanks down to ``depth`` (mm).
+
+    Every flank facet is sampled at its corners, edge midpoints, centroid and three points half a
+    facet beyond its edges (contact cells may overhang the flank's edge), and each sample is
+    moved along the facet's inward normal by ``depth · (0.1, 0.25, 0.5, 0.75, 1, 1.15)``: the
+    tetrahedra containing those points carry every displacement the ``hybrid`` fidelity reads at
+    a matching depth ``<= depth`` (it halves the depth near thin edges, which stays covered).
+    Every tetrahedron with a vertex on a flank is added (cells overhanging a flank edge).
+    """
+    facets = np.concatenate([mesh.boundaries[f] for f in flanks])
+    tri = mesh.p[:, mesh.facets[:, facets]].transpose(2, 1, 0)  # (nf, 3, 3)
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    # Orient outward: away from the fourth vertex of the facet's tetrahedron.
+    t = mesh.f2t[0, facets]
+    far = mesh.p[:, mesh.t[:, t]].mean(axis=1).T
+    flip = np.sum((far - tri.mean(axis=1)) * normal, axis=1) > 0
+    normal[flip] *= -1
+    w = np.array(
+        [
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [0.5, 0.5, 0],
+            [0, 0.5, 0.5],
+            [0.5, 0, 0.5],
+            [1 / 3, 1 / 3, 1 / 3],
+            [-0.5, 0.75, 0.75],
+            [0.75, -0.5, 0.75],
+            [0.75, 0.75, -0.5],
+        ]
+    )
+    samples = np.einsum("sk,fkx->fsx", w, tri)  # (nf, 10, 3)
+    out = []
+    for f in (0.1, 0.25, 0.5, 0.75, 1.0, 1.15):
+        pts = samples - f * depth * normal[:, None, :]
+        tets, _ = find_tets(mesh, pts.reshape(-1, 3))
+        out.append(tets[tets >= 0])
+    # ... and every tetrahedron with a vertex on a flank (cells overhang the flank edges).
+    on_flank = np.zeros(mesh.p.shape[1], dtype=bool)
+    on_flank[mesh.facets[:, facets].ravel()] = True
+    out.append(np.flatnonzero(on_flank[mesh.t].any(axis=0)))
+    return np.unique(np.concatenate(out))
 
 
 def member_load_operator(

@@ -1,0 +1,177 @@
+"""The speed/accuracy trade of the fidelities on the gear scenes (issue 7).
+
+For the seed face gear (`cases/face_gear_nominal.toml`, 3e6 N·mm on the face gear) and the
+reference spiral bevel (`cases/spiral_bevel_nominal.toml`, 100 N·m on the pinion), each
+``FIDELITY:LEVEL`` runs the loaded cycle twice in fresh processes:
+
+* cold: an empty mesh/operator cache (sector meshes, compliance operators, positions);
+* warm: the same case again on the cache the cold run left (operators read from disk).
+
+The times exclude the tooth-surface generation (the same for every fidelity; the bevel's machine
+settings take ~10-20 s). Peak memory is the child's maximum RSS. The errors are taken against the
+finest ``fe`` level run for the scene (the reference): load share of the pair (0, 0) (largest
+absolute difference over the positions), loaded TE peak-to-peak (relative), mean loaded TE, and
+p_max (relative), both over the whole cycle and over the positions where no pair touches a flank
+edge (edge contact makes the pressure singular: a grid-dependent number, not a converging one).
+
+Usage::
+
+    python benchmarks/bench_fidelity.py SCENE [FIDELITY:LEVEL ...]
+    python benchmarks/bench_fidelity.py face_gear fe:0 fe:1 fe:2 hertz:0 hybrid:0 hybrid:1
+    python benchmarks/bench_fidelity.py spiral_bevel fe:0 fe:1 fe:2 hertz:0 hybrid:0
+
+Writes benchmarks/results/fidelity_SCENE.json / .md (merged with earlier runs of other specs);
+`python benchmarks/plot_pareto.py` draws docs/fidelity/pareto_*.png from them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).parent
+ROOT = HERE.parent
+SCENES = {
+    "face_gear": (ROOT / "cases" / "face_gear_nominal.toml", 25),
+    "spiral_bevel": (ROOT / "cases" / "spiral_bevel_nominal.toml", 25),
+}
+CHILD = r"""
+import json, resource, sys, time
+import numpy as np
+from fegear.case import load_case
+from fegear.io.gear_case import build_pair
+from fegear.ltca import LTCAOptions, run_ltca
+path, fid, lv, npos = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+case = load_case(path)
+t0 = time.perf_counter()
+pair = build_pair(case)
+t_geom = time.perf_counter() - t0
+opt = LTCAOptions(n_positions=npos, level=lv, fidelity=fid, n_teeth=case.n_teeth,
+                  E_MPa=case.E_MPa, nu=case.nu)
+t0 = time.perf_counter()
+c = run_ltca(pair.pinion, pair.gear, pair.assembly, case.torque2_Nmm, opt)
+t = time.perf_counter() - t0
+edge = [any(q.edge_contact for q in p.pairs) for p in c.positions]
+pm = [max((q.p_max_MPa for q in p.pairs), default=0.0) for p in c.positions]
+pk = [max((q.p_peak_MPa for q in p.pairs), default=0.0) for p in c.positions]
+share = [sum(q.load_share for q in p.pairs if q.k == 0 and q.j == 0) for p in c.positions]
+print(json.dumps({
+    "fidelity": fid, "level": lv, "seconds": t, "geometry_s": t_geom, "stages": c.seconds,
+    "rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    "te_loaded": c.te_loaded_arcsec.tolist(), "te_pp": c.te_pp_loaded_arcsec,
+    "te_mean": float(np.mean(c.te_loaded_arcsec)), "contact_ratio": c.contact_ratio_loaded,
+    "p_max": pm, "p_peak": pk, "edge": edge, "share00": share,
+    "n_in_contact": c.n_in_contact.tolist(), "phi1_deg": np.degrees(c.phi1).tolist(),
+    "warnings": sorted({w.split(":")[0] for p in c.positions for w in p.warnings})[:5],
+}))
+"""
+
+
+def _child(path: Path, fid: str, level: int, npos: int, cache: str) -> dict:
+    env = dict(os.environ, FEGEAR_CACHE=cache)
+    res = subprocess.run(
+        [sys.executable, "-c", CHILD, str(path), fid, str(level), str(npos)],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    if res.returncode != 0:
+        tail = res.stderr.strip().splitlines()[-1] if res.stderr.strip() else "?"
+        return {"fidelity": fid, "level": level, "failed": tail}
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def run(scene: str, fid: str, level: int) -> dict:
+    path, npos = SCENES[scene]
+    with tempfile.TemporaryDirectory() as cache:
+        cold = _child(path, fid, level, npos, cache)
+        if "failed" in cold:
+            return cold
+        warm = _child(path, fid, level, npos, cache)
+    out = dict(cold)
+    out["cold_s"] = cold["seconds"]
+    out["warm_s"] = warm.get("seconds", float("nan"))
+    out["warm_stages"] = warm.get("stages", {})
+    out["rss_MB"] = max(cold["rss_MB"], warm.get("rss_MB", 0.0))
+    return out
+
+
+def _rel(a: float, b: float) -> float:
+    return (a - b) / b if b else float("nan")
+
+
+def errors(runs: list[dict]) -> tuple[dict, list[dict]]:
+    """Errors of every run against the finest ``fe`` level (the reference)."""
+    fe = [r for r in runs if r.get("fidelity") == "fe" and "failed" not in r]
+    ref = max(fe, key=lambda r: r["level"])
+    inner = [not e for e in ref["edge"]]
+    out = []
+    for r in runs:
+        if "failed" in r:
+            out.append(r)
+            continue
+        ok = [a and not b for a, b in zip(inner, r["edge"], strict=True)]
+        pm_in = max((p for p, k in zip(r["p_max"], ok, strict=True) if k), default=float("nan"))
+        pm_ref = max((p for p, k in zip(ref["p_max"], ok, strict=True) if k), default=float("nan"))
+        e = dict(r)
+        e["err_share"] = max(abs(a - b) for a, b in zip(r["share00"], ref["share00"], strict=True))
+        e["err_te_pp"] = _rel(r["te_pp"], ref["te_pp"])
+        e["err_te_mean"] = _rel(r["te_mean"], ref["te_mean"])
+        e["err_p_max"] = _rel(max(r["p_max"]), max(ref["p_max"]))
+        e["p_max_interior"] = pm_in
+        e["err_p_max_interior"] = _rel(pm_in, pm_ref)
+        e["n_interior"] = int(sum(ok))
+        out.append(e)
+    return ref, out
+
+
+def table(scene: str, runs: list[dict]) -> str:
+    ref, rows = errors(runs)
+    lines = [
+        f"# Fidelity trade: {scene.replace('_', ' ')}",
+        "",
+        f"`python benchmarks/bench_fidelity.py {scene} ...` (2 cores; reference: fe level "
+        f"{ref['level']}; times exclude the tooth-surface generation)",
+        "",
+        "| fidelity | level | cold s | warm s | peak RSS MB | TE p-p ″ | err TE p-p | mean TE ″ | "
+        "err mean TE | max share err (0,0) | p_max MPa | err p_max | p_max interior MPa | "
+        "err p_max interior (positions) | contact ratio |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    order = {"hertz": 0, "hybrid": 1, "fe": 2}
+    for r in sorted(rows, key=lambda r: (order.get(r["fidelity"], 9), r["level"])):
+        if "failed" in r:
+            lines.append(f"| {r['fidelity']} | {r['level']} | failed: {r['failed']} |")
+            continue
+        lines.append(
+            f"| {r['fidelity']} | {r['level']} | {r['cold_s']:.1f} | {r['warm_s']:.1f} | "
+            f"{r['rss_MB']:.0f} | {r['te_pp']:.3f} | {100 * r['err_te_pp']:+.1f}% | "
+            f"{r['te_mean']:.3f} | {100 * r['err_te_mean']:+.1f}% | {r['err_share']:.3f} | "
+            f"{max(r['p_max']):.0f} | {100 * r['err_p_max']:+.1f}% | "
+            f"{r['p_max_interior']:.0f} | {100 * r['err_p_max_interior']:+.1f}% "
+            f"({r['n_interior']}) | {r['contact_ratio']:.2f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    scene = sys.argv[1]
+    specs = [(a.split(":")[0], int(a.split(":")[1])) for a in sys.argv[2:]]
+    out_json = HERE / "results" / f"fidelity_{scene}.json"
+    runs = json.loads(out_json.read_text()) if out_json.exists() else []
+    for fid, lv in specs:
+        r = run(scene, fid, lv)
+        runs = [x for x in runs if (x["fidelity"], x["level"]) != (fid, lv)] + [r]
+        msg = r.get("failed") or f"cold {r['cold_s']:.1f} s, warm {r['warm_s']:.1f} s"
+        print(f"{scene} {fid}:{lv}: {msg}", flush=True)
+        out_json.write_text(json.dumps(runs, indent=1))
+    (HERE / "results" / f"fidelity_{scene}.md").write_text(table(scene, runs))
+    print(table(scene, runs))
+
+
+if __name__ == "__main__":
+    main()
