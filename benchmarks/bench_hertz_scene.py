@@ -9,7 +9,8 @@ Usage::
 
     python benchmarks/bench_hertz_scene.py [fe:L | hybrid:L:FE_L ...]   # default: all below
 
-Writes a Markdown table to stdout and to benchmarks/results/hertz_scene.md.
+Writes a Markdown table to stdout and to benchmarks/results/hertz_scene.md (rows also in
+hertz_scene.json, for `benchmarks/plot_pareto.py`).
 """
 
 from __future__ import annotations
@@ -89,6 +90,8 @@ def main() -> None:
     print(text)
     out = Path(__file__).parent / "results" / "hertz_scene.md"
     out.parent.mkdir(exist_ok=True)
+    rows_json = [dict(c, t_warm=w["t"], rss_MB=max(c["rss_MB"], w["rss_MB"])) for c, w in rows]
+    out.with_suffix(".json").write_text(json.dumps(rows_json, indent=1), encoding="utf-8")
     out.write_text(
         "# Hertz scene benchmark\n\n`python benchmarks/bench_hertz_scene.py`\n\n" + text + "\n",
         encoding="utf-8",

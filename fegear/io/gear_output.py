@@ -461,13 +461,7 @@ def _plot_pattern(out: Path, run: GearRun) -> Path:
         for c, p, q in zip(pos.cells, pos.pressure, pos.pairs, strict=True):
             if q.force_N <= 0:
                 continue
-            du = _spacing(c.uv[:, 0], float(c.cell_mm[0]))
-            dv = _spacing(c.uv[:, 1], float(c.cell_mm[1]))
-            for (u, v), pv in zip(c.uv[p > 0], p[p > 0], strict=True):
-                iu = (us >= u - du / 2) & (us <= u + du / 2)
-                iv = (vs >= v - dv / 2) & (vs <= v + dv / 2)
-                blk = P[np.ix_(iu, iv)]
-                P[np.ix_(iu, iv)] = np.maximum(blk, pv)
+            _paint_cells(P, us, vs, c, p)
             w = p * c.area
             path.append((w @ c.uv) / w.sum())
     fig, ax = plt.subplots(figsize=(7, 4.2))
@@ -494,6 +488,48 @@ def _plot_pattern(out: Path, run: GearRun) -> Path:
     ax.set_title(f"{_title(run)}\nloaded bearing pattern on the pinion flank", fontsize=9)
     fig.colorbar(im, ax=ax, label="max pressure over the cycle (MPa)")
     return _save(fig, out / "bearing_pattern.png")
+
+
+def _paint_cells(P: np.ndarray, us: np.ndarray, vs: np.ndarray, c, p: np.ndarray) -> None:
+    """Raise the pixels ``P[(us, vs)]`` that the loaded cells of ``c`` cover to their pressure.
+
+    The cells form a grid in their own axes (turned against ``(u, v)`` by the ``hybrid``
+    refinement): the affine map from the cells' intrinsic coordinates to ``(u, v)`` is fitted
+    on the cell centres, every pixel is taken back to cell coordinates and coloured by the
+    nearest cell when it lies within that cell (normalised distance below one half-diagonal).
+    """
+    from scipy.spatial import cKDTree
+
+    load = p > 0
+    if not load.any():
+        return
+    X = np.c_[c.local, np.ones(c.n)]
+    B, _, rank, _ = np.linalg.lstsq(X, c.uv, rcond=None)  # uv ≈ [local, 1] B
+    if rank < 3 or abs(np.linalg.det(B[:2])) < 1e-12 * np.abs(B[:2]).max() ** 2:
+        # A single row or column of cells (grid axes along u, v): boxes from the spacings.
+        du = _spacing(c.uv[:, 0], float(c.cell_mm[0]))
+        dv = _spacing(c.uv[:, 1], float(c.cell_mm[1]))
+        for (u, v), pv in zip(c.uv[load], p[load], strict=True):
+            iu = (us >= u - du / 2) & (us <= u + du / 2)
+            iv = (vs >= v - dv / 2) & (vs <= v + dv / 2)
+            P[np.ix_(iu, iv)] = np.maximum(P[np.ix_(iu, iv)], pv)
+        return
+    box = (c.uv[load].min(0), c.uv[load].max(0))
+    pad = np.abs(B[:2]).T @ c.cell_mm
+    iu = np.flatnonzero((us >= box[0][0] - pad[0]) & (us <= box[1][0] + pad[0]))
+    iv = np.flatnonzero((vs >= box[0][1] - pad[1]) & (vs <= box[1][1] + pad[1]))
+    if iu.size == 0 or iv.size == 0:
+        return
+    UU, VV = np.meshgrid(us[iu], vs[iv], indexing="ij")
+    uv = np.stack([UU.ravel(), VV.ravel()], -1)
+    loc = np.linalg.solve(B[:2].T, (uv - B[2]).T).T  # pixel -> cell coordinates
+    scale = np.asarray(c.cell_mm, dtype=float)
+    d, j = cKDTree(c.local[load] / scale).query(loc / scale)
+    hit = d <= 0.75
+    vals = np.zeros(uv.shape[0])
+    vals[hit] = p[load][j[hit]]
+    blk = P[np.ix_(iu, iv)]
+    P[np.ix_(iu, iv)] = np.maximum(blk, vals.reshape(UU.shape))
 
 
 def _spacing(x: np.ndarray, cell_mm: float) -> float:

@@ -24,6 +24,7 @@ The loaded TE is the unloaded TE minus the lag ``θ`` (arcsec).
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import dataclass
 
@@ -198,7 +199,8 @@ def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool
 
 
 def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
-    """Cells of every modelled pair within ``g_max`` and their contact solution."""
+    """Cells of every modelled pair within ``g_max`` and their contact solution; ``cell`` maps a
+    pair ``(k, j)`` to its cell sizes (key None: the size of the pairs not listed)."""
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
@@ -208,7 +210,8 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings):
                 warnings.append(msg)
                 log.warning(msg)
             continue
-        c = pair_cells(tca, pos, gi, cell, g_max)
+        su, sv, angle = cell.get((int(g.k), int(g.j)), cell[None])
+        c = pair_cells(tca, pos, gi, (su, sv), g_max, angle=angle)
         if c is not None:
             cells.append(c)
     if not cells:
@@ -314,23 +317,54 @@ def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
 
 
 def _refined_sizes(cells, sol, cell, n_across):
-    """Cell sizes giving ``n_across`` cells across the loaded patches, or None if fine enough."""
-    start, ext_u, ext_v = 0, [], []
+    """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
+    grids are fine enough.
+
+    The loaded patch of every pair is measured on its current grid by the force-weighted second
+    moments of the loaded cells (intrinsic cell coordinates): the eigenvectors give the major
+    direction ``M`` (minor ``m``), the eigenvalues ``λ`` the semi-axes ``sqrt(5 (λ + span²/12))``
+    (the Hertz pressure ``p0 sqrt(1 - x²/a² - y²/b²)`` has ``∫x² p / ∫p = a²/5``; a cell
+    spreads its force over its span). A cell of sizes
+    ``s = (s_ξ, s_η)`` spans ``|m|·s`` across the patch and ``|M|·s`` along it; the pair is
+    accepted when ``2b`` holds ``0.75 n_across`` such spans and ``2a`` as many, otherwise its
+    next grid is turned to the patch axes (``η`` along ``M``: the thin, long patches of gears are
+    oblique to the flank grid, and an unaligned grid fine enough across them has ``(a/b)²``
+    times more cells) with ``s = (2b, 2a) / (1.25 n_across)``, never coarser than the element-size
+    cells. Aiming above the target lets the next grid pass, as a coarse grid over-estimates the
+    patch. Each pair gets its own grid: a small patch (an edge contact carrying little load) does
+    not refine its neighbour.
+    """
+    start, new, refine = 0, {None: cell[None]}, False
+    base = cell[None][0]
     for c in cells:
-        act = sol.active[start : start + c.n]
+        F = sol.force[start : start + c.n]
         start += c.n
-        if not act.any():
+        key = (c.k, c.j)
+        now = cell.get(key, cell[None])
+        if not np.any(F > 0):
             continue
-        uv = c.uv[act]
-        ext_u.append(np.unique(uv[:, 0]).size * c.cell_mm[0])
-        ext_v.append(np.unique(uv[:, 1]).size * c.cell_mm[1])
-    if not ext_u:
-        return None
-    su = min(cell[0], min(ext_u) / n_across)
-    sv = min(cell[1], min(ext_v) / n_across)
-    if su >= 0.99 * cell[0] and sv >= 0.99 * cell[1]:
-        return None
-    return (su, sv)
+        w = F / F.sum()
+        x = c.local - w @ c.local
+        lam, vec = np.linalg.eigh((x * w[:, None]).T @ x)
+        M = vec[:, 1]
+        size = np.asarray(now[:2])
+        span_b, span_a = np.abs(M[::-1]) @ size, np.abs(M) @ size
+        # Each cell smears its force over its span (variance span²/12): a patch one cell wide
+        # measures at least that width.
+        b2 = 2.0 * np.sqrt(5.0 * (max(lam[0], 0.0) + span_b**2 / 12.0))
+        a2 = 2.0 * np.sqrt(5.0 * (max(lam[1], 0.0) + span_a**2 / 12.0))
+        if b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_across * span_a:
+            new[key] = now
+            continue
+        refine = True
+        turn = math.atan2(M[1], M[0]) - 0.5 * math.pi  # η onto the major axis
+        angle = math.remainder(now[2] + turn, math.pi)
+        new[key] = (
+            min(base, b2 / (1.25 * n_across)),
+            min(base, a2 / (1.25 * n_across)),
+            angle,
+        )
+    return new if refine else None
 
 
 def solve_position(
@@ -346,7 +380,7 @@ def solve_position(
     warnings: list[str] = []
     # Pass 1: cells of the default size; g_max doubled until no left-out cell could touch.
     g_max = g_max_mm
-    cell = (models.cell_mm, models.cell_mm)
+    cell = {None: (models.cell_mm, models.cell_mm, 0.0)}
     for _attempt in range(8):
         cells, sol = _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings)
         if sol is None:

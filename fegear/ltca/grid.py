@@ -59,9 +59,11 @@ class PairCells:
     half_widths
         ``(n, 2)`` mm, half the cell sizes along u and v (from the exact flank tangents).
     cell_mm
-        ``(2,)`` mm, cell sizes along ``u`` and ``v``.
+        ``(2,)`` mm, cell sizes along the cell axes ``ξ`` and ``η``.
     boundary
         ``(n,)`` bool, the cell touches a boundary of the working flank of either member.
+    angle
+        rad, the cell axes ``ξ, η`` are the ``u, v`` arc-length directions turned by ``angle``.
     """
 
     k: int
@@ -77,6 +79,7 @@ class PairCells:
     half_widths: Array
     cell_mm: Array
     boundary: NDArray[np.bool_]
+    angle: float = 0.0
 
     @property
     def n(self) -> int:
@@ -104,15 +107,23 @@ def _separation(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
     return apply_points(Mk, P), apply_vectors(Mk, N), np.where(ok, s, 0.0), h, ok, gear_uv
 
 
-def _aligned(x0: float, x1: float, dx: float, xc: float, lo: float, hi: float) -> Array:
-    """Cell centres of size ``dx`` covering ``[x0, x1]``, one of them at ``xc``, with their
-    centres within the flank bounds ``[lo, hi]`` (an end cell may overhang the bound by less
-    than half a cell; its load is located on the nearest flank facet)."""
-    k0 = math.floor((x0 - xc) / dx + 0.5)
-    k1 = math.ceil((x1 - xc) / dx - 0.5)
-    c = xc + dx * np.arange(k0, k1 + 1)
-    c = c[(c >= lo) & (c <= hi)]
-    return c if c.size else np.array([min(max(xc, lo), hi)])
+def _centres(x0: float, x1: float, dx: float) -> Array:
+    """Cell centres ``k dx`` (one at 0, the pair's closest point) covering ``[x0, x1]``."""
+    k0 = math.floor(x0 / dx + 0.5)
+    k1 = math.ceil(x1 / dx - 0.5)
+    return dx * np.arange(k0, k1 + 1)
+
+
+def _chords(X: Array, axis: int) -> Array:
+    """Cumulative chord lengths along one grid direction of the points ``X`` (nξ, nη, 3), mean
+    over the other direction; chords through points off the flank (NaN) take the median chord."""
+    seg = np.linalg.norm(np.diff(X, axis=axis), axis=-1)
+    fin = np.isfinite(seg)
+    seg = np.where(fin, seg, 0.0).sum(axis=1 - axis) / np.maximum(fin.sum(axis=1 - axis), 1)
+    seg[~fin.any(axis=1 - axis)] = np.nan
+    fill = np.nanmedian(seg) if np.any(np.isfinite(seg)) else 0.0
+    seg = np.where(np.isfinite(seg), seg, fill)
+    return np.concatenate([[0.0], np.cumsum(seg)])
 
 
 def pair_cells(
@@ -122,6 +133,7 @@ def pair_cells(
     cell_mm: float | tuple[float, float],
     g_max: float,
     max_cells: int = 4000,
+    angle: float = 0.0,
 ) -> PairCells | None:
     """Fine contact cells of one pair at one position, or None if no cell is within ``g_max``.
 
@@ -134,11 +146,16 @@ def pair_cells(
     grid_index
         Index into ``pos.grids``.
     cell_mm
-        Target cell size (mm), or ``(along u, along v)``.
+        Target cell size (mm), or ``(along ξ, along η)``.
     g_max
         mm, cells with a larger separation cannot take load at the load considered.
     max_cells
-        Cap on the cells of the box; both sizes grow in proportion if it would be exceeded.
+        Cap on the cells kept; both sizes grow in proportion if it would be exceeded.
+    angle
+        rad, rotation of the cell grid: the cell axes ``ξ, η`` are the flank's ``u`` and ``v``
+        arc-length directions turned by ``angle`` (the ``hybrid`` fidelity aligns its cells with
+        the contact ellipse, which is oblique to the flank grid in general). With ``angle = 0``
+        ``ξ = u``, ``η = v``.
     """
     cu_mm, cv_mm = (cell_mm, cell_mm) if np.isscalar(cell_mm) else cell_mm
     g = pos.grids[grid_index]
@@ -146,68 +163,79 @@ def pair_cells(
     near = g.valid & (g.separation <= g_max)
     if not near.any():
         return None
-    # Dilate by one coarse cell and take the bounding box in (u, v).
-    iu, iv = np.nonzero(near)
-    nu, nv = g.valid.shape
     b = tca.fm1.bounds
+    nu, nv = g.valid.shape
     du_c, dv_c = g.u[1] - g.u[0], g.v[1] - g.v[0]
-    u0 = max(b.u_fillet, g.u[max(iu.min() - 1, 0)] - 0.5 * du_c)
-    u1 = min(b.u_tip, g.u[min(iu.max() + 1, nu - 1)] + 0.5 * du_c)
-    v0 = max(b.v_start, g.v[max(iv.min() - 1, 0)] - 0.5 * dv_c)
-    v1 = min(b.v_end, g.v[min(iv.max() + 1, nv - 1)] + 0.5 * dv_c)
     # Lengths (mm) per unit u and v from the coarse grid points.
     P = g.points
     lu = np.linalg.norm(P[1:, :, :] - P[:-1, :, :], axis=-1).mean() / du_c if nu > 1 else 1.0
     lv = np.linalg.norm(P[:, 1:, :] - P[:, :-1, :], axis=-1).mean() / dv_c if nv > 1 else 1.0
-    n_u = max(1, int(math.ceil((u1 - u0) * lu / cu_mm)))
-    n_v = max(1, int(math.ceil((v1 - v0) * lv / cv_mm)))
-    if n_u * n_v > max_cells:
-        f = math.sqrt(max_cells / (n_u * n_v))
-        n_u, n_v = max(1, int(n_u * f)), max(1, int(n_v * f))
-    du, dv = (u1 - u0) / n_u, (v1 - v0) / n_v
-    # Align the cells on the pair's closest point (a cell centre on it), so that the
-    # discretisation is the same for every pair and every position (no cell-phase jitter).
+    # The cell grid: centres (u, v) = (uc, vc) + A (ξ, η), A = diag(1/lu, 1/lv) R(angle), with a
+    # centre on the pair's closest point, so that the discretisation is the same for every pair
+    # and position (no cell-phase jitter).
     ip = int(np.flatnonzero((pos.pairs[:, 0] == g.k) & (pos.pairs[:, 1] == g.j))[0])
     uc, vc = pos.pinion_uv[ip]
-    cu = _aligned(u0, u1, du, uc, b.u_fillet, b.u_tip)
-    cv = _aligned(v0, v1, dv, vc, b.v_start, b.v_end)
-    CU, CV = np.meshgrid(cu, cv, indexing="ij")
-    ts = -pos.te_rad
-    X, N, s, h, ok, guv = _separation(tca, pos.phi1, ts, i, CU, CV)
-    keep = ok & (s <= g_max)
+    ca, sa = math.cos(angle), math.sin(angle)
+    A = np.array([[ca / lu, -sa / lu], [sa / lv, ca / lv]])
+    Ainv = np.linalg.inv(A)
+    # The coarse cells within g_max, dilated by one coarse cell, in (ξ, η).
+    iu, iv = np.nonzero(near)
+    corner_u, corner_v = np.array([-1.5, 1.5, -1.5, 1.5]), np.array([-1.5, -1.5, 1.5, 1.5])
+    U_near = np.clip(g.u[iu][:, None] + du_c * corner_u, b.u_fillet, b.u_tip)
+    V_near = np.clip(g.v[iv][:, None] + dv_c * corner_v, b.v_start, b.v_end)
+    xe = np.einsum("ij,jnk->ink", Ainv, np.stack([U_near - uc, V_near - vc]))
+    lo, hi = xe.reshape(2, -1).min(axis=1), xe.reshape(2, -1).max(axis=1)
+    for _ in range(3):
+        cx, cy = _centres(lo[0], hi[0], cu_mm), _centres(lo[1], hi[1], cv_mm)
+        XI, ETA = np.meshgrid(cx, cy, indexing="ij")
+        CU = uc + A[0, 0] * XI + A[0, 1] * ETA
+        CV = vc + A[1, 0] * XI + A[1, 1] * ETA
+        inside = (CU >= b.u_fillet) & (CU <= b.u_tip) & (CV >= b.v_start) & (CV <= b.v_end)
+        ts = -pos.te_rad
+        X, N, s, h, ok, guv = _separation(tca, pos.phi1, ts, i, CU, CV)
+        keep = inside & ok & (s <= g_max)
+        if keep.sum() <= max_cells:
+            break
+        f = math.sqrt(keep.sum() / max_cells) * 1.05
+        cu_mm, cv_mm = cu_mm * f, cv_mm * f
     if not keep.any():
         return None
     # 2 x 2 Gauss points of the kept cells (exact pinion flank, fixed frame).
-    gu = CU[keep][:, None, None] + 0.5 * du * _GAUSS2[None, :, None]
-    gv = CV[keep][:, None, None] + 0.5 * dv * _GAUSS2[None, None, :]
-    gu, gv = np.broadcast_arrays(gu, gv)
+    gx = XI[keep][:, None, None] + 0.5 * cu_mm * _GAUSS2[None, :, None]
+    gy = ETA[keep][:, None, None] + 0.5 * cv_mm * _GAUSS2[None, None, :]
+    gx, gy = np.broadcast_arrays(gx, gy)
+    gu = uc + A[0, 0] * gx + A[0, 1] * gy
+    gv = vc + A[1, 0] * gx + A[1, 1] * gy
     qa, qb = tca.fm1.native(gu.reshape(-1), gv.reshape(-1))
     Pq, _ = tca.fm1.evaluate(qa, qb)
     Mk = compose(tca.asm.placement1(pos.phi1), tooth_transform(tca.asm.n1, g.k))
     quad = apply_points(Mk, Pq).reshape(-1, 4, 3)
-    # Areas from the Gauss points: |r_u x r_v| du dv by central differences of the 2x2 points.
+    # Areas from the Gauss points: |r_ξ x r_η| dξ dη by central differences of the 2x2 points.
     q = quad.reshape(-1, 2, 2, 3)
-    ru = (q[:, 1, :, :] - q[:, 0, :, :]).mean(axis=1) / (du / math.sqrt(3.0))
-    rv = (q[:, :, 1, :] - q[:, :, 0, :]).mean(axis=1) / (dv / math.sqrt(3.0))
-    area = np.linalg.norm(np.cross(ru, rv), axis=-1) * du * dv
-    # Intrinsic flank coordinates (mm): cumulative chord lengths along the u and v grid lines,
+    rx = (q[:, 1, :, :] - q[:, 0, :, :]).mean(axis=1) / (cu_mm / math.sqrt(3.0))
+    ry = (q[:, :, 1, :] - q[:, :, 0, :]).mean(axis=1) / (cv_mm / math.sqrt(3.0))
+    area = np.linalg.norm(np.cross(rx, ry), axis=-1) * cu_mm * cv_mm
+    # Intrinsic flank coordinates (mm): cumulative chord lengths along the ξ and η grid lines,
     # so that the cells tile the plane without overlap even where the flank is strongly curved
     # (a projection on one tangent plane would squeeze the far cells together).
-    su = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=-1).mean(1))])
-    sv = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=1), axis=-1).mean(0))])
-    IU, IV = np.meshgrid(np.arange(CU.shape[0]), np.arange(CU.shape[1]), indexing="ij")
+    Xg = np.where((inside & ok)[..., None], X, np.nan)
+    su, sv = _chords(Xg, 0), _chords(Xg, 1)
+    IU, IV = np.meshgrid(np.arange(XI.shape[0]), np.arange(XI.shape[1]), indexing="ij")
     lu_, lv_ = su[IU[keep]], sv[IV[keep]]
     local = np.stack([lu_ - lu_.mean(), lv_ - lv_.mean()], -1)
     half_widths = 0.5 * np.stack(
-        [np.linalg.norm(ru, axis=-1) * du, np.linalg.norm(rv, axis=-1) * dv], -1
+        [np.linalg.norm(rx, axis=-1) * cu_mm, np.linalg.norm(ry, axis=-1) * cv_mm], -1
     )
+    du, dv = cu_mm, cv_mm  # cell sizes along ξ, η (mm)
     # Cells touching a working-flank boundary of the pinion or the gear.
     tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
+    hu = 0.5 * (abs(A[0, 0]) * du + abs(A[0, 1]) * dv)  # half extent of a cell along u, v
+    hv = 0.5 * (abs(A[1, 0]) * du + abs(A[1, 1]) * dv)
     on_p = (
-        (CU - 0.5 * du <= b.u_fillet + tu)
-        | (CU + 0.5 * du >= b.u_tip - tu)
-        | (CV - 0.5 * dv <= b.v_start + tv)
-        | (CV + 0.5 * dv >= b.v_end - tv)
+        (CU - hu <= b.u_fillet + tu)
+        | (CU + hu >= b.u_tip - tu)
+        | (CV - hv <= b.v_start + tv)
+        | (CV + hv >= b.v_end - tv)
     )
     b2 = tca.fm2.bounds
     su, sv = 0.01 * (b2.u_tip - b2.u_fillet), 0.01 * (b2.v_end - b2.v_start)
@@ -229,6 +257,7 @@ def pair_cells(
         area=area,
         local=local,
         half_widths=half_widths,
-        cell_mm=np.array([du * lu, dv * lv]),
+        cell_mm=np.array([du, dv]),
+        angle=float(angle),
         boundary=(on_p | on_g)[keep],
     )
