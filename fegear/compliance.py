@@ -319,7 +319,8 @@ def candidate_operator(
                 np.save(fh, compute())
 
         path, hit = cached_file("compliance", params, ".npy", build)
-        G = np.load(path)
+        # Memory-mapped: a position reads only the rows and columns its cells touch.
+        G = np.load(path, mmap_mode="r")
     dt = time.perf_counter() - t0
     log.info("candidate operator: %d DOFs in %.2f s (%s)", c.size, dt, "cache" if hit else used)
     return CandidateOperator(
