@@ -302,14 +302,24 @@ def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
         sl = slice(start, start + c.n)
         S = C1[sl, sl] + C2[sl, sl]
         s0 = subsurface_influence(c.local, 0.0, c.local, c.half_widths, models.E, models.nu)
+        full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
         for dd in (d1[sl], d2[sl]):
             S += 0.5 * (s0 + s0.T)
             for depth in np.unique(dd):
                 rows = np.flatnonzero(dd == depth)
                 sd = np.zeros((c.n, c.n))
-                sd[rows] = subsurface_influence(
-                    c.local[rows], float(depth), c.local, c.half_widths, models.E, models.nu
-                )
+                if depth == 0.0:
+                    sd[rows] = s0[rows]
+                elif rows.size > c.n // 4:
+                    if float(depth) not in full:
+                        full[float(depth)] = subsurface_influence(
+                            c.local, float(depth), c.local, c.half_widths, models.E, models.nu
+                        )
+                    sd[rows] = full[float(depth)][rows]
+                else:
+                    sd[rows] = subsurface_influence(
+                        c.local[rows], float(depth), c.local, c.half_widths, models.E, models.nu
+                    )
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
         start += c.n
