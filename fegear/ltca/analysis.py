@@ -340,9 +340,11 @@ def _refined_sizes(cells, sol, cell, n_across):
     next grid is turned to the patch axes (``η`` along ``M``: the thin, long patches of gears are
     oblique to the flank grid, and an unaligned grid fine enough across them has ``(a/b)²``
     times more cells) with ``s = (2b, 2a) / (1.25 n_across)``, never coarser than the element-size
-    cells. Aiming above the target lets the next grid pass, as a coarse grid over-estimates the
-    patch. Each pair gets its own grid: a small patch (an edge contact carrying little load) does
-    not refine its neighbour.
+    cells. A grid whose cells are less than 0.4 times the area of those (too fine, or turned
+    away from the patch: a pair's grid starts from the previous position's, where its patch may
+    have been much smaller) is re-made the same way. Aiming above the target lets the next grid
+    pass, as a coarse grid over-estimates the patch. Each pair gets its own grid: a small patch
+    (an edge contact carrying little load) does not refine its neighbour.
     """
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
@@ -363,17 +365,15 @@ def _refined_sizes(cells, sol, cell, n_across):
         # measures at least that width.
         b2 = 2.0 * np.sqrt(5.0 * (max(lam[0], 0.0) + span_b**2 / 12.0))
         a2 = 2.0 * np.sqrt(5.0 * (max(lam[1], 0.0) + span_a**2 / 12.0))
-        if b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_across * span_a:
+        ideal = (min(base, b2 / (1.25 * n_across)), min(base, a2 / (1.25 * n_across)))
+        fine = b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_across * span_a
+        wasteful = size[0] * size[1] < 0.4 * ideal[0] * ideal[1]
+        if fine and not wasteful:
             new[key] = now
             continue
         refine = True
         turn = math.atan2(M[1], M[0]) - 0.5 * math.pi  # η onto the major axis
-        angle = math.remainder(now[2] + turn, math.pi)
-        new[key] = (
-            min(base, b2 / (1.25 * n_across)),
-            min(base, a2 / (1.25 * n_across)),
-            angle,
-        )
+        new[key] = (*ideal, math.remainder(now[2] + turn, math.pi))
     return new if refine else None
 
 
@@ -383,14 +383,25 @@ def solve_position(
     models: MemberModels,
     torque2_Nmm: float,
     g_max_mm: float,
+    previous: LoadedPosition | None = None,
 ) -> LoadedPosition:
-    """Loaded contact at one TCA position (see the module docstring)."""
+    """Loaded contact at one TCA position (see the module docstring).
+
+    ``previous`` (``hybrid``): the solution at the neighbouring position; its refined cell grids
+    and ``g_max`` start this one (the patches move little from one position to the next, so the
+    first solve is usually already fine enough: one or two solves instead of three or four).
+    """
     if not pos.has_contact:
         return _no_contact(pos, "no contact: the flanks do not meet at this position")
     warnings: list[str] = []
-    # Pass 1: cells of the default size; g_max doubled until no left-out cell could touch.
+    # Pass 1: cells of the default size (or the previous position's grids); g_max doubled until
+    # no left-out cell could touch.
     g_max = g_max_mm
     cell = {None: (models.cell_mm, models.cell_mm, 0.0)}
+    if models.fidelity == "hybrid" and previous is not None and previous.cells:
+        g_max = previous.g_max_mm
+        for c in previous.cells:
+            cell[(c.k, c.j)] = (float(c.cell_mm[0]), float(c.cell_mm[1]), c.angle)
     for _attempt in range(8):
         cells, sol = _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings)
         if sol is None:
@@ -531,7 +542,8 @@ def run_ltca(
 
             out.append(solve_position_hertz(tca, pos, models, torque2_Nmm, opt.E_MPa, opt.nu))
         else:
-            out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm))
+            prev = out[-1] if out else None
+            out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm, prev))
         if progress is not None:
             progress(i + 1, len(tca_pos))
     seconds["positions"] = time.perf_counter() - t0

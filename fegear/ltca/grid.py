@@ -191,8 +191,24 @@ def pair_cells(
         CU = uc + A[0, 0] * XI + A[0, 1] * ETA
         CV = vc + A[1, 0] * XI + A[1, 1] * ETA
         inside = (CU >= b.u_fillet) & (CU <= b.u_tip) & (CV >= b.v_start) & (CV <= b.v_end)
-        ts = -pos.te_rad
-        X, N, s, h, ok, guv = _separation(tca, pos.phi1, ts, i, CU, CV)
+        if not inside.any():
+            return None
+        # Only grid points on the flank are evaluated (the flank map may not extend far).
+        shp = CU.shape
+        X, N = np.full(shp + (3,), np.nan), np.full(shp + (3,), np.nan)
+        s, h, guv = np.full(shp, np.inf), np.zeros(shp), np.zeros(shp + (2,))
+        ok = np.zeros(shp, dtype=bool)
+        Xi, Ni, si, hi_, oki, guvi = _separation(
+            tca, pos.phi1, -pos.te_rad, i, CU[inside], CV[inside]
+        )
+        X[inside], N[inside], s[inside], h[inside], ok[inside], guv[inside] = (
+            Xi,
+            Ni,
+            si,
+            hi_,
+            oki,
+            guvi,
+        )
         keep = inside & ok & (s <= g_max)
         if keep.sum() <= max_cells:
             break
