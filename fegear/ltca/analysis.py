@@ -19,6 +19,26 @@ At each mesh position (DESIGN §8):
    so the rigid test is conservative).
 
 The loaded TE is the unloaded TE minus the lag ``θ`` (arcsec).
+
+The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair. The FE cannot resolve a
+patch narrower than its elements (cells finer than the P2 elements make ``PᵀK⁻¹P``
+rank-deficient), so, after Vijayakar (1991, IJNME 31, 525), the approach of cell ``i`` is split at
+a matching point ``y_i = x_i + d e_i`` a depth ``d`` below it (``e_i`` the inward normal):
+
+    w_i = Q_iᵀ K⁻¹ P F  +  Σ_j [u_hs(x_i; j) − u_hs(y_i; j)] F_j      (for each member)
+
+the FE read at depth (where the coarse mesh no longer has to resolve the pressure's near field)
+plus the closed-form compression of the layer ``[0, d]`` of a half-space under uniform pressure
+on rectangular cells (Love 1929 for the surface, the Boussinesq integral below it:
+:func:`fegear.halfspace.subsurface_influence`); the part of the near field the coarse FE
+carries above ``y_i`` is never used, so nothing is counted twice. ``d = min(2h, 0.35 m)`` is tied
+to the element size, so the layer shrinks as the FE is refined and the hybrid tends to the pure
+FE answer (shown on the Hertz scene: ``tests/test_hybrid.py``). The FE part is symmetrised.
+Between pairs (different teeth) the plain ``PᵀK⁻¹P`` coupling is used. The operator of each
+member covers the DOFs of the tetrahedra down to ``d`` below its working flanks; a matching point
+outside them moves up (``d`` halved), and a cell overhanging the flank edge reads the FE at the
+surface. The cells of each pair are refined on a grid turned to its patch's axes
+(:func:`_refined_sizes`), starting from the previous position's grid.
 """
 
 from __future__ import annotations
@@ -82,7 +102,7 @@ class LTCAOptions:
     fidelity
         ``"fe"``: the contact grid with the FE compliance (cells one element wide).
         ``"hertz"``: per-pair Hertz laws and lumped FE compliance (:mod:`fegear.ltca.hertz_model`).
-        ``"hybrid"`` (experimental): the FE read at a matching depth ``d`` below every cell plus
+        ``"hybrid"``: the FE read at a matching depth ``d`` below every cell plus
         the closed-form half-space compression of the layer above it (Vijayakar 1991; the split
         validated on the Hertz scene, :func:`fegear.scenes.hertz_scene.hybrid_compliance`),
         inside each pair; plain ``PᵀK⁻¹P`` between pairs. The cells are refined below the

@@ -146,8 +146,9 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
             d_ref = local.approach(torque2_Nmm / h_i)
         else:
             # line contact: its length is the extent, along the flat direction, of the band of
-            # cells within 20 µm of the closest separation
-            cells = pair_cells(tca, pos, gi, models.cell_mm, b_i + 0.02)
+            # cells within 20 µm of the closest separation (cells of an eighth of the element
+            # size: the length is then known to 1/8 element, not to a whole cell)
+            cells = pair_cells(tca, pos, gi, models.cell_mm / 8.0, b_i + 0.02)
             length = 0.0
             if cells is not None:
                 e = (
