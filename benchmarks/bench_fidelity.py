@@ -104,9 +104,9 @@ def _rel(a: float, b: float) -> float:
     return (a - b) / b if b else float("nan")
 
 
-def errors(runs: list[dict]) -> tuple[dict, list[dict]]:
-    """Errors of every run against the finest ``fe`` level (the reference)."""
-    fe = [r for r in runs if r.get("fidelity") == "fe" and "failed" not in r]
+def errors(runs: list[dict], reference: str = "fe") -> tuple[dict, list[dict]]:
+    """Errors of every run against the finest level of the ``reference`` fidelity."""
+    fe = [r for r in runs if r.get("fidelity") == reference and "failed" not in r]
     ref = max(fe, key=lambda r: r["level"])
     inner = [not e for e in ref["edge"]]
     out = []
