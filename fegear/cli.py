@@ -123,17 +123,26 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     say(
         f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
         f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
-        + (f", level {lvl}" if fid == "fe" else "")
+        + (f", level {lvl}" if fid != "tca" else "")
         + f", {case.n_positions} positions, out {out}/"
     )
     stage_t = {"t": t_start}
-    if fid == "fe":
+    if fid in ("fe", "hybrid"):
+        layer = " and their layer below the flanks" if fid == "hybrid" else ""
         labels = {
             "geometry": "[1/5] geometry and assembly",
-            "models": "[2/5] sector meshes and compliance operators (cached after the first run)",
+            "models": f"[2/5] sector meshes and compliance operators{layer} (cached after the "
+            "first run)",
             "positions": "[3/5] mesh positions (TCA + contact)",
             "displacements": "[4/5] displacement fields (one sparse solve per member)",
             "writing": "[5/5] writing outputs",
+        }
+    elif fid == "hertz":
+        labels = {
+            "geometry": "[1/4] geometry and assembly",
+            "models": "[2/4] sector meshes and compliance operators (cached after the first run)",
+            "positions": "[3/4] mesh positions (TCA + Hertz laws)",
+            "writing": "[4/4] writing outputs",
         }
     else:
         labels = {
@@ -163,6 +172,12 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             f"{c.te_pp_loaded_arcsec:.2f} arcsec; loaded contact ratio "
             f"{c.contact_ratio_loaded:.2f}; p_max {c.p_max_MPa:.0f} MPa"
         )
+        inner = [q.p_max_MPa for p in c.positions for q in p.pairs if not q.edge_contact]
+        if any(q.edge_contact for p in c.positions for q in p.pairs):
+            say(
+                "    edge contact at some positions (pressure there is singular, grid-dependent); "
+                f"p_max away from the edges {max(inner, default=0.0):.0f} MPa"
+            )
         n_warn = sum(bool(p.warnings) for p in c.positions)
         if n_warn:
             say(f"    warning: {n_warn} positions with warnings (see summary.json)")
