@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import logging
 import time
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,6 +101,23 @@ class CandidateOperator:
     backend: str
 
 
+_TREES: dict[tuple[int, str], tuple[weakref.ref, cKDTree]] = {}
+
+
+def _tree(mesh: skfem.MeshTet, what: str, centres) -> cKDTree:
+    """KD-tree of the tetrahedron (``what = "tets"``) or boundary-facet centroids of ``mesh``,
+    built once per mesh object (mesh positions query the same sector hundreds of times) and
+    dropped with the mesh."""
+    key = (id(mesh), what)
+    hit = _TREES.get(key)
+    if hit is not None and hit[0]() is mesh:
+        return hit[1]
+    tree = cKDTree(centres())
+    _TREES[key] = (weakref.ref(mesh), tree)
+    weakref.finalize(mesh, _TREES.pop, key, None)
+    return tree
+
+
 def locate_on_boundary(
     mesh: skfem.MeshTet, boundary: str, points: np.ndarray, k: int = 12
 ) -> SurfacePoints:
@@ -124,7 +142,7 @@ def locate_on_boundary(
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     fac = mesh.boundaries[boundary]
     tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3 nodes, 3 xyz)
-    tree = cKDTree(tri.mean(axis=1))
+    tree = _tree(mesh, boundary, lambda: tri.mean(axis=1))
     kk = min(k, fac.size)
     _, cand = tree.query(pts, k=kk)
     cand = cand.reshape(pts.shape[0], kk)
@@ -240,9 +258,9 @@ def find_tets(
     """Tetrahedron containing each point (-1 if none of the ``k`` nearest by centroid does) and
     the point's reference coordinates in it. Vectorised barycentric test."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
-    cen = mesh.p[:, mesh.t].mean(axis=1).T
-    kk = min(k, cen.shape[0])
-    _, cand = cKDTree(cen).query(pts, k=kk)
+    tree = _tree(mesh, "tets", lambda: mesh.p[:, mesh.t].mean(axis=1).T)
+    kk = min(k, mesh.t.shape[1])
+    _, cand = tree.query(pts, k=kk)
     cand = cand.reshape(pts.shape[0], kk)
     tv = np.moveaxis(mesh.p[:, mesh.t[:, cand]], 0, -1)  # (4, npts, kk, 3)
     J = np.stack([tv[1] - tv[0], tv[2] - tv[0], tv[3] - tv[0]], axis=-1)  # (npts, kk, 3, 3)

@@ -282,13 +282,14 @@ def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
     return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
 
 
-def _hybrid_member(model, M, x, inward, P, depth: float) -> tuple[np.ndarray, np.ndarray]:
-    """FE part of the hybrid compliance of one member, ``sym(Qᵀ (K⁻¹)_cc P)``, ``Q`` reading the
-    displacement along the inward normal at ``x + d e``. A matching point that would leave the
-    tooth, or fall in a tetrahedron outside the operator's layer, moves up by halving ``d``; a
-    cell whose point is still outside after three halvings (a cell overhanging the flank edge)
-    reads the FE at the surface, through its own load column (``d = 0``: no layer correction).
-    Returns the matrix and the depths used."""
+def _hybrid_probe(model, M, x, inward, P, depth: float) -> tuple[sp.csc_matrix, np.ndarray]:
+    """Matching-point readings of one member for the FE part of the hybrid compliance,
+    ``sym(Qᵀ (K⁻¹)_cc P)``: ``Q`` reads the displacement along the inward normal at ``x + d e``.
+    A matching point that would leave the tooth, or fall in a tetrahedron outside the operator's
+    layer, moves up by halving ``d``; a cell whose point is still outside after three halvings (a
+    cell overhanging the flank edge) reads the FE at the surface, through its own load column
+    (``d = 0``: no layer correction).
+    Returns ``Q`` (n_dofs × n) and the depths used."""
     Minv = inverse(M)
     e = apply_vectors(Minv, inward)
     x0 = apply_points(Minv, x)
@@ -307,8 +308,7 @@ def _hybrid_member(model, M, x, inward, P, depth: float) -> tuple[np.ndarray, np
         log.debug("%s: %d hybrid cells read at the surface", model.name, int(bad.sum()))
         order = np.concatenate([good, np.flatnonzero(bad)])
         Q = sp.hstack([Q, sp.csc_matrix(P)[:, bad]]).tocsc()[:, np.argsort(order)]
-    Cf = cross_compliance(model.op, Q, P)
-    return 0.5 * (Cf + Cf.T), d
+    return sp.csc_matrix(Q), d
 
 
 def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
@@ -322,13 +322,23 @@ def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
     x1 = np.concatenate([c.centers for c in cells])
     x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in cells])
     P1, P2 = _load_operators(models, M1, M2, cells)
-    C1, d1 = _hybrid_member(models.pinion, M1, x1, -n1, P1, models.depth_mm)
-    C2, d2 = _hybrid_member(models.gear, M2, x2, n1, P2, models.depth_mm)
-    C = member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
-    start = 0
-    for c in cells:
-        sl = slice(start, start + c.n)
-        S = C1[sl, sl] + C2[sl, sl]
+    P1, P2 = P1.tocsc(), P2.tocsc()
+    Q1, d1 = _hybrid_probe(models.pinion, M1, x1, -n1, P1, models.depth_mm)
+    Q2, d2 = _hybrid_probe(models.gear, M2, x2, n1, P2, models.depth_mm)
+    ops = ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
+    ends = np.cumsum([0] + [c.n for c in cells])
+    blocks = [slice(ends[i], ends[i + 1]) for i in range(len(cells))]
+    C = np.zeros((int(ends[-1]), int(ends[-1])))
+    # Between pairs: the plain surface coupling of both members (upper blocks, mirrored).
+    for ia, sa in enumerate(blocks):
+        for sb in blocks[ia + 1 :]:
+            C[sa, sb] = sum(cross_compliance(op, P[:, sa], P[:, sb]) for op, _, P in ops)
+            C[sb, sa] = C[sa, sb].T
+    for c, sl in zip(cells, blocks, strict=True):
+        S = np.zeros((c.n, c.n))
+        for op, Q, P in ops:
+            Cf = cross_compliance(op, Q[:, sl], P[:, sl])
+            S += 0.5 * (Cf + Cf.T)
         s0 = subsurface_influence(c.local, 0.0, c.local, c.half_widths, models.E, models.nu)
         full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
         for dd in (d1[sl], d2[sl]):
@@ -350,7 +360,6 @@ def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
                     )
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
-        start += c.n
     return C
 
 
