@@ -13,6 +13,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+from cli_checks import assert_refused, one_line
 
 from fegear.case import load_case
 from fegear.cli import main
@@ -62,12 +63,6 @@ BAD_CASES = [
 ]
 
 
-def _one_line(err: str) -> str:
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1, err
-    return lines[0]
-
-
 @pytest.mark.parametrize(
     ("text", "words"), [c[1:] for c in BAD_CASES], ids=[c[0] for c in BAD_CASES]
 )
@@ -76,12 +71,7 @@ def test_malformed_case_is_refused_with_one_line(tmp_path, capsys, text, words):
     path.write_text(text, encoding="utf-8")
     out = tmp_path / "out"
     code = main(["run", str(path), "--out", str(out)])
-    err = capsys.readouterr().err
-    assert code == 2, err
-    line = _one_line(err)
-    assert line.startswith("fegear: error: "), line
-    for w in words:
-        assert w in line, f"{w!r} not in {line!r}"
+    assert_refused(code, capsys.readouterr().err, words)
     assert not out.exists()  # refused before any work
 
 
@@ -96,14 +86,14 @@ def test_bad_command_line_values_are_refused(tmp_path, capsys, argv, word):
     code = main(["run", str(CASE), "--out", str(tmp_path / "out"), *argv])
     err = capsys.readouterr().err
     assert code == 2, err
-    assert word in _one_line(err)
+    assert word in one_line(err)
 
 
 def test_missing_case_file_is_refused(tmp_path, capsys):
     code = main(["run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err
     assert code == 2
-    assert "nope.toml" in _one_line(err)
+    assert "nope.toml" in one_line(err)
 
 
 # --------------------------------------------------------------------------------------------
@@ -222,7 +212,7 @@ def test_swapped_radii_are_refused_when_the_case_loads(tmp_path, capsys):
     code = main(["run", str(path), "--level", "0", "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err
     assert code == 2
-    assert "roller.radii_mm" in _one_line(err)
+    assert "roller.radii_mm" in one_line(err)
 
 
 @pytest.mark.parametrize(
@@ -236,4 +226,4 @@ def test_scene_errors_name_the_case_file_key(tmp_path, capsys, old, new, field):
     path = tmp_path / "bad.toml"
     path.write_text(_edit(old, new), encoding="utf-8")
     assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
-    assert _one_line(capsys.readouterr().err).startswith(f"fegear: error: {field} = ")
+    assert one_line(capsys.readouterr().err).startswith(f"fegear: error: {field} = ")

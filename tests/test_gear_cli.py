@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_checks import assert_refused, one_line
 
 from fegear.case import HertzCase, load_case
 from fegear.cli import main
@@ -28,12 +29,6 @@ CASES = sorted((REPO / "cases").glob("*.toml"))
 FZG = REPO / "cases" / "fzg_spur.toml"
 FACE_GEAR = REPO / "cases" / "face_gear_nominal.toml"
 BEVEL = REPO / "cases" / "spiral_bevel_nominal.toml"
-
-
-def _one_line(err: str) -> str:
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1, err
-    return lines[0]
 
 
 # --------------------------------------------------------------------------------------------
@@ -170,12 +165,7 @@ def test_malformed_gear_case_is_refused_with_one_line(tmp_path, capsys, text, wo
     path.write_text(text, encoding="utf-8")
     out = tmp_path / "out"
     code = main(["run", str(path), "--out", str(out)])
-    err = capsys.readouterr().err
-    assert code == 2, err
-    line = _one_line(err)
-    assert line.startswith("fegear: error: "), line
-    for w in words:
-        assert w in line, f"{w!r} not in {line!r}"
+    assert_refused(code, capsys.readouterr().err, words)
     assert not out.exists()  # refused before any work
 
 
@@ -192,7 +182,7 @@ def test_bad_command_line_values_for_a_gear_case(tmp_path, capsys, argv, word):
     code = main(["run", str(FZG), "--out", str(out), *argv])
     err = capsys.readouterr().err
     assert code == 2, err
-    assert word in _one_line(err)
+    assert word in one_line(err)
     assert not out.exists()
 
 

@@ -184,9 +184,9 @@ def test_hertz_fidelity_balances_and_agrees_with_fe_on_load_sharing(setup, cycle
         for q in p_f.pairs:
             # both models share the FE body compliance; they differ in the local contact law
             # (Palmgren line law vs FE cells one element wide): shares within 0.05 (measured
-            # up to 0.045 at level 0)
+            # up to 0.046 at level 0)
             assert abs(share_h.get((q.k, q.j), 0.0) - q.load_share) < 0.05
-    # the loaded TE of both is a lag of the same order (measured: hertz 11-21 % larger, the
+    # the loaded TE of both is a lag of the same order (measured: hertz 17-25 % larger, the
     # FE at level 0 being locally stiff); a factor 1.5 bounds it
     ratio = hz.te_loaded_arcsec / cycle.te_loaded_arcsec
     assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio

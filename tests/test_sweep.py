@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
+from cli_checks import assert_refused, one_line
 
 from fegear.cli import main
 from fegear.sweep import MARKER, build_items, parse_grid
@@ -23,12 +24,6 @@ from fegear.sweep import MARKER, build_items, parse_grid
 REPO = Path(__file__).resolve().parents[1]
 FZG = REPO / "cases" / "fzg_spur.toml"
 N_POS = 3
-
-
-def _one_line(err: str) -> str:
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1, err
-    return lines[0]
 
 
 @pytest.fixture(scope="module")
@@ -243,7 +238,7 @@ def test_scheduler_without_dask_is_one_line(fzg3, tmp_path, capsys, monkeypatch)
     out = tmp_path / "sweep"
     code = main(["sweep", str(fzg3), "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"])
     assert code == 1
-    line = _one_line(capsys.readouterr().err)
+    line = one_line(capsys.readouterr().err)
     assert "Dask" in line and "pip install" in line, line
 
 
@@ -280,24 +275,19 @@ BAD = [
 def test_bad_grid_is_one_line_exit_2(fzg3, tmp_path, capsys, argv, words):
     out = tmp_path / "sweep"
     code = main(["sweep", str(fzg3), "--out", str(out), *argv])
-    err = capsys.readouterr().err
-    assert code == 2, err
-    line = _one_line(err)
-    assert line.startswith("fegear: error: "), line
-    for w in words:
-        assert w in line, f"{w!r} not in {line!r}"
+    assert_refused(code, capsys.readouterr().err, words)
     if argv[0] != "--nominal":
         assert not out.exists()  # refused before any work
 
 
 def test_bad_case_file_and_duplicate_names(fzg3, tmp_path, capsys):
     assert main(["sweep", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "o")]) == 2
-    assert "missing.toml" in _one_line(capsys.readouterr().err)
+    assert "missing.toml" in one_line(capsys.readouterr().err)
     assert main(["sweep", str(fzg3), str(fzg3), "--out", str(tmp_path / "o")]) == 2
-    assert "distinct case names" in _one_line(capsys.readouterr().err)
+    assert "distinct case names" in one_line(capsys.readouterr().err)
     hertz = REPO / "cases" / "hertz_scene.toml"
     assert main(["sweep", str(hertz), "--out", str(tmp_path / "o")]) == 2
-    assert "a gear pair" in _one_line(capsys.readouterr().err)
+    assert "a gear pair" in one_line(capsys.readouterr().err)
     assert not (tmp_path / "o").exists()
 
 
@@ -321,5 +311,5 @@ def test_one_sweep_per_folder(fzg3, tmp_path, capsys):
     with open(out / ".sweep.lock", "w") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)  # another sweep holds the folder
         assert main(["sweep", str(fzg3), "--out", str(out), "-q"]) == 1
-    assert "another sweep is writing" in _one_line(capsys.readouterr().err)
+    assert "another sweep is writing" in one_line(capsys.readouterr().err)
     assert not (out / "fzg_spur").exists()

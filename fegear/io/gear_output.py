@@ -31,9 +31,7 @@ Files written to the output folder (each one atomically: complete or absent):
 
 from __future__ import annotations
 
-import importlib.metadata
 import math
-import platform
 from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
@@ -43,21 +41,11 @@ import numpy as np
 from fegear.geometry.transforms import apply_points, apply_vectors
 from fegear.io.files import atomic_write, write_json
 from fegear.io.gear_run import GearRun
+from fegear.io.records import solver_record, versions
 
 __all__ = ["write_gear_outputs", "gear_summary", "write_pvd"]
 
 ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
-
-
-def _versions() -> dict[str, str]:
-    out = {"python": platform.python_version()}
-    for pkg in ("fegear", "numpy", "scipy", "scikit-fem", "gmsh", "meshio", "matplotlib",
-                "pypardiso"):  # fmt: skip
-        try:
-            out[pkg] = importlib.metadata.version(pkg)
-        except importlib.metadata.PackageNotFoundError:
-            out[pkg] = "not installed"
-    return out
 
 
 def _f(x: float) -> float | None:
@@ -114,11 +102,7 @@ def _fe_positions(run: GearRun) -> list[dict[str, Any]]:
                 "p_max_MPa": p.p_max_MPa,
                 "pairs": [_pair_row(q, k) for k, q in enumerate(p.pairs)],
                 "solver": {
-                    "iterations": s.iterations,
-                    "equilibrium_residual": s.equilibrium_residual,
-                    "complementarity_residual": s.complementarity_residual,
-                    "max_penetration_mm": s.max_penetration,
-                    "min_active_force_N": s.min_active_force,
+                    **solver_record(s),
                     "n_cells": int(s.force.size),
                     "g_max_mm": p.g_max_mm,
                 },
@@ -229,7 +213,7 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
             warnings.append("unloaded TCA only: the spiral bevel loaded analysis is not available")
     doc["warnings"] = warnings
     doc["files"] = files or []
-    doc["versions"] = _versions()
+    doc["versions"] = versions()
     return doc
 
 

@@ -288,10 +288,7 @@ def run_gear_case(
         progress=lambda i, n: say("positions", i, n),
     )
     seconds["positions"] = time.perf_counter() - t0
-    # The gear phase run_ltca used (same TCA options: deterministic, ~0.2-2 s).
-    tca_opt = TCAOptions(n_positions=opt.n_positions, separation_grid=opt.tca_grid,
-                         E_MPa=opt.E_MPa, nu=opt.nu)  # fmt: skip
-    asm = pair.assembly.with_phase2(reference_phase(pair.pinion, pair.gear, pair.assembly, tca_opt))
+    asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds)
     if case.fidelity == "hertz":  # no contact grid: no cell loads, no displacement fields
         return run

@@ -16,27 +16,16 @@ Files written to the output folder:
 
 from __future__ import annotations
 
-import importlib.metadata
 import math
-import platform
 from pathlib import Path
 
 import numpy as np
 
 from fegear.io.files import atomic_write, write_json
+from fegear.io.records import solver_record, versions
 from fegear.scenes.hertz_scene import HertzLevelResult, HertzScene
 
 __all__ = ["write_hertz_outputs", "hertz_summary", "level_row"]
-
-
-def _versions() -> dict[str, str]:
-    out = {"python": platform.python_version()}
-    for pkg in ("fegear", "numpy", "scipy", "scikit-fem", "gmsh", "meshio", "pyvista"):
-        try:
-            out[pkg] = importlib.metadata.version(pkg)
-        except importlib.metadata.PackageNotFoundError:
-            out[pkg] = "not installed"
-    return out
 
 
 def level_row(r: HertzLevelResult) -> dict[str, object]:
@@ -111,18 +100,14 @@ def hertz_summary(
         },
         "errors": {k: r.error(k) for k in ("p0", "a", "b", "approach")},
         "solver": {
-            "iterations": s.iterations,
-            "equilibrium_residual": s.equilibrium_residual,
-            "complementarity_residual": s.complementarity_residual,
-            "max_penetration_mm": s.max_penetration,
-            "min_active_force_N": s.min_active_force,
+            **solver_record(s),
             "backend": r.backend,
         },
         "mesh": {"dofs": r.dofs, "cell_size_mm": r.cell_size_mm, "element_size_mm": r.h_fine_mm},
         "timings_s": r.seconds,
         "levels": [level_row(x) for x in study] if study else [],
         "convergence_rate": rate or {},
-        "versions": _versions(),
+        "versions": versions(),
     }
 
 

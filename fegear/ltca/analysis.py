@@ -594,4 +594,5 @@ def run_ltca(
         fidelity=opt.fidelity,
         level=opt.level,
         seconds=seconds,
+        phase2=float(asm.phase2),
     )

@@ -132,6 +132,9 @@ class LoadedCycle:
         How the compliance was modelled.
     seconds
         Wall times of the stages.
+    phase2
+        rad, the member-2 phase the TCA closed the pair with (``assembly.with_phase2(phase2)`` is
+        the assembly every position was solved in).
     """
 
     positions: tuple[LoadedPosition, ...]
@@ -143,6 +146,7 @@ class LoadedCycle:
     fidelity: str
     level: int
     seconds: dict[str, float]
+    phase2: float = 0.0
 
     @property
     def te_pp_unloaded_arcsec(self) -> float:
