@@ -441,6 +441,9 @@ def solve_position(
             cell[(c.k, c.j)] = (float(c.cell_mm[0]), float(c.cell_mm[1]), c.angle)
     for _attempt in range(8):
         cells, sol = _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings)
+        if sol is None and g_max < g_max_mm:  # the previous position's g_max was too small
+            g_max = g_max_mm
+            continue
         if sol is None:
             edge = pos.edge[pos.contact_pair] if pos.contact_pair >= 0 else ""
             why = (
