@@ -101,21 +101,37 @@ class CandidateOperator:
     backend: str
 
 
-_TREES: dict[tuple[int, str], tuple[weakref.ref, cKDTree]] = {}
+_MEMO: dict[tuple[int, str], tuple[weakref.ref, object]] = {}
+
+
+def _memo(mesh: skfem.MeshTet, what: str, build):
+    """``build()`` once per mesh object and ``what`` (mesh positions query the same sector
+    hundreds of times), dropped with the mesh."""
+    key = (id(mesh), what)
+    hit = _MEMO.get(key)
+    if hit is not None and hit[0]() is mesh:
+        return hit[1]
+    value = build()
+    _MEMO[key] = (weakref.ref(mesh), value)
+    weakref.finalize(mesh, _MEMO.pop, key, None)
+    return value
 
 
 def _tree(mesh: skfem.MeshTet, what: str, centres) -> cKDTree:
-    """KD-tree of the tetrahedron (``what = "tets"``) or boundary-facet centroids of ``mesh``,
-    built once per mesh object (mesh positions query the same sector hundreds of times) and
-    dropped with the mesh."""
-    key = (id(mesh), what)
-    hit = _TREES.get(key)
-    if hit is not None and hit[0]() is mesh:
-        return hit[1]
-    tree = cKDTree(centres())
-    _TREES[key] = (weakref.ref(mesh), tree)
-    weakref.finalize(mesh, _TREES.pop, key, None)
-    return tree
+    """KD-tree of the tetrahedron (``what = "tets"``) or boundary-facet centroids of ``mesh``."""
+    return _memo(mesh, "tree:" + what, lambda: cKDTree(centres()))
+
+
+def _tet_affine(mesh: skfem.MeshTet) -> tuple[np.ndarray, np.ndarray]:
+    """First vertices ``p0`` (n_tets, 3) and inverse Jacobians ``J⁻¹`` (n_tets, 3, 3) of the
+    affine maps ``x = p0 + J ξ`` of all tetrahedra (scikit-fem's reference tetrahedron)."""
+
+    def build():
+        tv = np.moveaxis(mesh.p[:, mesh.t], 0, -1)  # (4, n_tets, 3)
+        J = np.stack([tv[1] - tv[0], tv[2] - tv[0], tv[3] - tv[0]], axis=-1)
+        return tv[0], np.linalg.inv(J)
+
+    return _memo(mesh, "affine", build)
 
 
 def locate_on_boundary(
@@ -262,9 +278,8 @@ def find_tets(
     kk = min(k, mesh.t.shape[1])
     _, cand = tree.query(pts, k=kk)
     cand = cand.reshape(pts.shape[0], kk)
-    tv = np.moveaxis(mesh.p[:, mesh.t[:, cand]], 0, -1)  # (4, npts, kk, 3)
-    J = np.stack([tv[1] - tv[0], tv[2] - tv[0], tv[3] - tv[0]], axis=-1)  # (npts, kk, 3, 3)
-    xi = np.linalg.solve(J, (pts[:, None, :] - tv[0])[..., None])[..., 0]
+    p0, Jinv = _tet_affine(mesh)
+    xi = np.einsum("nkij,nkj->nki", Jinv[cand], pts[:, None, :] - p0[cand])  # (npts, kk, 3)
     bmin = np.minimum(xi.min(axis=-1), 1.0 - xi.sum(axis=-1))
     best = np.argmax(bmin, axis=1)
     rows = np.arange(pts.shape[0])

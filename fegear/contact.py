@@ -161,6 +161,7 @@ def solve_contact(
     *,
     penetration_tol: float | None = None,
     max_iterations: int | None = None,
+    active_guess: np.ndarray | None = None,
 ) -> ContactSolution:
     """Solve the normal contact problem (see the module docstring).
 
@@ -180,6 +181,13 @@ def solve_contact(
         the scale of the problem ``max(|theta| max h, max g - min g, mean diag(C) T)``.
     max_iterations
         Safety cap; default ``10 n + 100``.
+    active_guess
+        (n,) bool, optional guess of the cells in contact (e.g. from a neighbouring solution). The
+        iterate still starts feasible from the single closest cell, but the first sub-problem is
+        solved on the guess together with it: cells of the guess that get no force leave at once
+        (a step of length zero), so a good guess saves most of the outer iterations and a bad one
+        costs one factorisation. The solution does not depend on it (the problem is strictly
+        convex).
 
     Returns
     -------
@@ -199,6 +207,11 @@ def solve_contact(
     F[start] = T / h[start]
     active = np.zeros(n, dtype=bool)
     active[start] = True
+    if active_guess is not None:
+        guess = np.asarray(active_guess, dtype=bool).ravel()
+        if guess.shape != (n,):
+            raise InputError("active_guess", f"shape {guess.shape}", f"shape ({n},)")
+        active |= guess
     theta = 0.0
     single_add = False
     f_prev = np.inf  # objective after the previous outer step

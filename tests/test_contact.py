@@ -646,3 +646,36 @@ def test_exact_zero_subproblem_force_is_clean() -> None:
         warnings.simplefilter("error")
         sol = solve_contact(np.eye(3), np.array([0.0, 0.0, 0.5]), 1.0)
     np.testing.assert_array_equal(sol.force, [0.5, 0.5, 0.0])
+
+
+# ----------------------------------------------------------------------------------------------
+# warm start (active_guess): the solution is the QP's, whatever the guess
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("guess", ["exact", "rigid-overlap", "all", "none-active", "random"])
+def test_active_guess_changes_the_path_not_the_solution(sphere6, guess: str) -> None:
+    C, g, _ = sphere6
+    h = np.ones(g.size)
+    cold = solve_contact(C, g, LOAD)
+    mask = {
+        "exact": cold.active,
+        "rigid-overlap": g - cold.theta < 0.0,  # the rigid interpenetration: a superset
+        "all": np.ones(g.size, dtype=bool),
+        "none-active": ~cold.active,
+        "random": np.random.default_rng(3).random(g.size) < 0.5,
+    }[guess]
+    warm = solve_contact(C, g, LOAD, active_guess=mask)
+    _assert_kkt(C, g, h, LOAD, warm, tol=1e-10)
+    # strictly convex QP: one minimiser; the two paths differ by round-off of the factorisations
+    np.testing.assert_allclose(warm.force, cold.force, rtol=0, atol=1e-9 * cold.force.max())
+    np.testing.assert_array_equal(warm.active, cold.active)
+    if guess == "exact":  # one sub-problem on the right set, and the check that nothing penetrates
+        assert warm.iterations == 1 < cold.iterations
+
+
+def test_active_guess_of_the_wrong_length_is_refused(sphere6) -> None:
+    C, g, _ = sphere6
+    with pytest.raises(InputError) as info:
+        solve_contact(C, g, LOAD, active_guess=np.ones(g.size + 1, dtype=bool))
+    assert info.value.field == "active_guess"

@@ -64,6 +64,9 @@ class PairCells:
         ``(n,)`` bool, the cell touches a boundary of the working flank of either member.
     angle
         rad, the cell axes ``ξ, η`` are the ``u, v`` arc-length directions turned by ``angle``.
+    origin
+        ``(3,)`` fixed frame, the pair's closest point of the TCA on the pinion flank (the grid's
+        origin; it rolls along the flank from one position to the next with the contact).
     """
 
     k: int
@@ -80,6 +83,7 @@ class PairCells:
     cell_mm: Array
     boundary: NDArray[np.bool_]
     angle: float = 0.0
+    origin: Array | None = None
 
     @property
     def n(self) -> int:
@@ -276,4 +280,5 @@ def pair_cells(
         cell_mm=np.array([du, dv]),
         angle=float(angle),
         boundary=(on_p | on_g)[keep],
+        origin=np.asarray(pos.points[ip], dtype=float),
     )
