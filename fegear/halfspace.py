@@ -26,9 +26,30 @@ solver (a Hertz contact on a half-space has a known answer).
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 __all__ = ["rectangle_integral", "halfspace_influence", "subsurface_influence"]
+
+#: Field points per block of the row-parallel evaluation (a block of 64 x ~500 cells stays in
+#: cache: measured 25 % faster than the whole matrix at once on one thread).
+_BLOCK = 64
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def _pool() -> ThreadPoolExecutor:
+    """Threads for the row blocks (numpy's ufuncs release the GIL on large arrays): one pool per
+    process (a forked worker does not inherit the parent's threads), ``$FEGEAR_THREADS`` threads
+    (set by the loaded cycle's workers to their share of the cores), else one per core."""
+    pid = os.getpid()
+    if pid not in _POOLS:
+        n = int(os.environ.get("FEGEAR_THREADS", "0")) or min(8, os.cpu_count() or 1)
+        _POOLS[pid] = ThreadPoolExecutor(max_workers=n)
+    return _POOLS[pid]
 
 
 def _f(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
@@ -133,9 +154,16 @@ def subsurface_influence(
     numpy.ndarray
         (n, m) mm/N: displacement at point ``i`` per unit force spread on cell ``j``.
     """
-    pts = np.asarray(points, dtype=float)
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
     c = np.asarray(centers, dtype=float)
     hw = np.asarray(half_widths, dtype=float)
+    n = pts.shape[0]
+    if n > _BLOCK and n * c.shape[0] > 20_000:
+        # Row blocks on all cores: 2.5x faster on 2 cores for 500 x 500 (bit-identical: the
+        # entries are independent).
+        blocks = [slice(i, min(i + _BLOCK, n)) for i in range(0, n, _BLOCK)]
+        parts = _pool().map(lambda b: subsurface_influence(pts[b], depth, c, hw, E, nu), blocks)
+        return np.vstack(list(parts))
     area = (4.0 * hw[:, 0] * hw[:, 1])[None, :]
     x = pts[:, 0][:, None]
     y = pts[:, 1][:, None]

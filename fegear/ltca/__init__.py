@@ -1,6 +1,7 @@
 """Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair (DESIGN §7-§10)."""
 
-from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, run_ltca, solve_position
+from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, solve_position
+from fegear.ltca.cycle import run_ltca
 from fegear.ltca.grid import PairCells, pair_cells
 from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
 

@@ -20,58 +20,36 @@ At each mesh position (DESIGN §8):
 
 The loaded TE is the unloaded TE minus the lag ``θ`` (arcsec).
 
-The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair. The FE cannot resolve a
-patch narrower than its elements (cells finer than the P2 elements make ``PᵀK⁻¹P``
-rank-deficient), so, after Vijayakar (1991, IJNME 31, 525), the approach of cell ``i`` is split at
-a matching point ``y_i = x_i + d e_i`` a depth ``d`` below it (``e_i`` the inward normal):
-
-    w_i = Q_iᵀ K⁻¹ P F  +  Σ_j [u_hs(x_i; j) − u_hs(y_i; j)] F_j      (for each member)
-
-the FE read at depth (where the coarse mesh no longer has to resolve the pressure's near field)
-plus the closed-form compression of the layer ``[0, d]`` of a half-space under uniform pressure
-on rectangular cells (Love 1929 for the surface, the Boussinesq integral below it:
-:func:`fegear.halfspace.subsurface_influence`); the part of the near field the coarse FE
-carries above ``y_i`` is never used, so nothing is counted twice. ``d = min(2h, 0.35 m)`` is tied
-to the element size, so the layer shrinks as the FE is refined and the hybrid tends to the pure
-FE answer (shown on the Hertz scene: ``tests/test_hybrid.py``). The FE part is symmetrised.
-Between pairs (different teeth) the plain ``PᵀK⁻¹P`` coupling is used. The operator of each
-member covers the DOFs of the tetrahedra down to ``d`` below its working flanks; a matching point
-outside them moves up (``d`` halved), and a cell overhanging the flank edge reads the FE at the
-surface. The cells of each pair are refined on a grid turned to its patch's axes
-(:func:`_refined_sizes`), starting from the previous position's grid.
+The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair: see
+:mod:`fegear.ltca.hybrid`. :func:`fegear.ltca.cycle.run_ltca` runs the positions of a cycle.
 """
 
 from __future__ import annotations
 
 import logging
-import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
-from fegear.compliance import cross_compliance, find_tets, probe_operator
 from fegear.contact import solve_contact
 from fegear.errors import InputError
-from fegear.geometry.transforms import apply_points, apply_vectors, inverse
-from fegear.halfspace import subsurface_influence
 from fegear.ltca.grid import PairCells, pair_cells
+from fegear.ltca.hybrid import hybrid_compliance, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
     build_member_model,
+    cell_load_operators,
     member_compliance,
-    member_load_operator,
 )
-from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
+from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.warm import active_guess, footprint
 from fegear.mesh.sector import FINE, sector_mesh
 from fegear.patch import measure_patch
-from fegear.tca import TCA, TCAOptions
-from fegear.tca.cached import cached_tca
+from fegear.tca import TCA
 from fegear.tca.results import ARCSEC, PositionResult
 
-__all__ = ["LTCAOptions", "MemberModels", "build_models", "solve_position", "run_ltca"]
+__all__ = ["LTCAOptions", "MemberModels", "build_models", "solve_position"]
 
 log = logging.getLogger(__name__)
 
@@ -127,6 +105,13 @@ class LTCAOptions:
     depth_elements, depth_max_modules
         ``hybrid``: ``d = min(depth_elements h, depth_max_modules m)`` (``h`` the fine element
         size, ``m`` the module). Measured on the FZG pair: positive definite from d = 1.1 h.
+    chunk_positions
+        Positions solved in sequence, each from its predecessor (:mod:`fegear.ltca.cycle`); a
+        chunk's first position starts from the default cells. Part of the method: the result
+        depends on it (``hybrid``: within the grid-refinement tolerance, measured 0.2 % in TE on
+        the seed face gear), not on ``workers``.
+    workers
+        Processes solving the chunks in parallel; None: one per core (at most one per chunk).
     """
 
     n_positions: int = 25
@@ -143,10 +128,16 @@ class LTCAOptions:
     max_cells: int = 600
     depth_elements: float = 2.0
     depth_max_modules: float = 0.35
+    chunk_positions: int = 13
+    workers: int | None = None
 
     def __post_init__(self) -> None:
         if self.fidelity not in ("fe", "hertz", "hybrid"):
             raise InputError("fidelity", self.fidelity, "'fe', 'hertz' or 'hybrid'")
+        if not (isinstance(self.chunk_positions, int) and self.chunk_positions >= 1):
+            raise InputError("chunk_positions", self.chunk_positions, "an integer >= 1")
+        if self.workers is not None and not (isinstance(self.workers, int) and self.workers >= 1):
+            raise InputError("workers", self.workers, "an integer >= 1, or None for all cores")
 
 
 @dataclass(frozen=True)
@@ -264,170 +255,15 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
     return cells, solve_contact(C, gap, torque2_Nmm, weights=h, active_guess=guess)
 
 
-def _load_operators(models, M1, M2, cells) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """Consistent loads of all cells on both members: along ``−n1`` on the pinion flank, along
-    ``+n1`` at the same points moved across the gap onto the gear flank."""
-    P1 = sp.hstack(
-        [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
-    ).tocsr()
-    P2 = sp.hstack(
-        [
-            member_load_operator(
-                models.gear,
-                M2,
-                c.j,
-                c.quad_points + c.gap[:, None, None] * c.normals[:, None],
-                c.normals,
-            )
-            for c in cells
-        ]
-    ).tocsr()
-    return P1, P2
-
-
 def _solve_cells_compliance(tca, pos, models, cells) -> np.ndarray:
     """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
     if models.fidelity == "hybrid":
-        return _hybrid_compliance(tca, pos, models, cells)
+        return hybrid_compliance(tca, pos, models, cells)
     asm = tca.asm
     M1 = asm.placement1(pos.phi1)
     M2 = asm.placement2(pos.phi2)
-    P1, P2 = _load_operators(models, M1, M2, cells)
+    P1, P2 = cell_load_operators(models, M1, M2, cells)
     return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
-
-
-def _hybrid_probe(model, M, x, inward, P, depth: float) -> tuple[sp.csc_matrix, np.ndarray]:
-    """Matching-point readings of one member for the FE part of the hybrid compliance,
-    ``sym(Qᵀ (K⁻¹)_cc P)``: ``Q`` reads the displacement along the inward normal at ``x + d e``.
-    A matching point that would leave the tooth, or fall in a tetrahedron outside the operator's
-    layer, moves up by halving ``d``; a cell whose point is still outside after three halvings (a
-    cell overhanging the flank edge) reads the FE at the surface, through its own load column
-    (``d = 0``: no layer correction).
-    Returns ``Q`` (n_dofs × n) and the depths used."""
-    Minv = inverse(M)
-    e = apply_vectors(Minv, inward)
-    x0 = apply_points(Minv, x)
-    d = np.full(x0.shape[0], depth)
-    for _ in range(4):
-        tets, _ = find_tets(model.body.mesh, x0 + d[:, None] * e)
-        bad = tets < 0
-        bad[~bad] = ~model.layer_tets[tets[~bad]]
-        if not bad.any():
-            break
-        d[bad] *= 0.5
-    good = np.flatnonzero(~bad)
-    Q = probe_operator(model.body, x0[good] + d[good, None] * e[good], e[good])
-    if bad.any():
-        d[bad] = 0.0
-        log.debug("%s: %d hybrid cells read at the surface", model.name, int(bad.sum()))
-        order = np.concatenate([good, np.flatnonzero(bad)])
-        Q = sp.hstack([Q, sp.csc_matrix(P)[:, bad]]).tocsc()[:, np.argsort(order)]
-    return sp.csc_matrix(Q), d
-
-
-def _hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
-    """Hybrid compliance: inside each pair, FE at the matching depth + the half-space compression
-    of the layer ``[0, d]`` of each member (cells in intrinsic flank coordinates); between pairs
-    (different teeth, far apart) the plain surface coupling ``PᵀK⁻¹P``."""
-    asm = tca.asm
-    M1 = asm.placement1(pos.phi1)
-    M2 = asm.placement2(pos.phi2)
-    n1 = np.concatenate([c.normals for c in cells])
-    x1 = np.concatenate([c.centers for c in cells])
-    x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in cells])
-    P1, P2 = _load_operators(models, M1, M2, cells)
-    P1, P2 = P1.tocsc(), P2.tocsc()
-    Q1, d1 = _hybrid_probe(models.pinion, M1, x1, -n1, P1, models.depth_mm)
-    Q2, d2 = _hybrid_probe(models.gear, M2, x2, n1, P2, models.depth_mm)
-    ops = ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
-    ends = np.cumsum([0] + [c.n for c in cells])
-    blocks = [slice(ends[i], ends[i + 1]) for i in range(len(cells))]
-    C = np.zeros((int(ends[-1]), int(ends[-1])))
-    # Between pairs: the plain surface coupling of both members (upper blocks, mirrored).
-    for ia, sa in enumerate(blocks):
-        for sb in blocks[ia + 1 :]:
-            C[sa, sb] = sum(cross_compliance(op, P[:, sa], P[:, sb]) for op, _, P in ops)
-            C[sb, sa] = C[sa, sb].T
-    for c, sl in zip(cells, blocks, strict=True):
-        S = np.zeros((c.n, c.n))
-        for op, Q, P in ops:
-            Cf = cross_compliance(op, Q[:, sl], P[:, sl])
-            S += 0.5 * (Cf + Cf.T)
-        s0 = subsurface_influence(c.local, 0.0, c.local, c.half_widths, models.E, models.nu)
-        full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
-        for dd in (d1[sl], d2[sl]):
-            S += 0.5 * (s0 + s0.T)
-            for depth in np.unique(dd):
-                rows = np.flatnonzero(dd == depth)
-                sd = np.zeros((c.n, c.n))
-                if depth == 0.0:
-                    sd[rows] = s0[rows]
-                elif rows.size > c.n // 4:
-                    if float(depth) not in full:
-                        full[float(depth)] = subsurface_influence(
-                            c.local, float(depth), c.local, c.half_widths, models.E, models.nu
-                        )
-                    sd[rows] = full[float(depth)][rows]
-                else:
-                    sd[rows] = subsurface_influence(
-                        c.local[rows], float(depth), c.local, c.half_widths, models.E, models.nu
-                    )
-                S -= 0.5 * (sd + sd.T)
-        C[sl, sl] = S
-    return C
-
-
-def _refined_sizes(cells, sol, cell, n_across, remake=False):
-    """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
-    grids are fine enough.
-
-    The loaded patch of every pair is measured on its current grid by the force-weighted second
-    moments of the loaded cells (intrinsic cell coordinates): the eigenvectors give the major
-    direction ``M`` (minor ``m``), the eigenvalues ``λ`` the semi-axes ``sqrt(5 (λ + span²/12))``
-    (the Hertz pressure ``p0 sqrt(1 - x²/a² - y²/b²)`` has ``∫x² p / ∫p = a²/5``; a cell
-    spreads its force over its span). A cell of sizes
-    ``s = (s_ξ, s_η)`` spans ``|m|·s`` across the patch and ``|M|·s`` along it; the pair is
-    accepted when ``2b`` holds ``0.75 n_across`` such spans and ``2a`` as many, otherwise its
-    next grid is turned to the patch axes (``η`` along ``M``: the thin, long patches of gears are
-    oblique to the flank grid, and an unaligned grid fine enough across them has ``(a/b)²``
-    times more cells) with ``s = (2b, 2a) / (1.25 n_across)``, never coarser than the element-size
-    cells. A grid whose cells are less than 0.4 times the area of those (too fine, or turned
-    away from the patch: a pair's grid starts from the previous position's, where its patch may
-    have been much smaller) is re-made the same way. Aiming above the target lets the next grid
-    pass, as a coarse grid over-estimates the patch. Each pair gets its own grid: a small patch
-    (an edge contact carrying little load) does not refine its neighbour. ``remake``: every
-    loaded pair gets the grid made for its patch, accepted or not (the start of the next
-    position); pairs without load are left out (they start from the default cells).
-    """
-    start, new, refine = 0, {None: cell[None]}, False
-    base = cell[None][0]
-    for c in cells:
-        F = sol.force[start : start + c.n]
-        start += c.n
-        key = (c.k, c.j)
-        now = cell.get(key, cell[None])
-        if not np.any(F > 0):
-            continue
-        w = F / F.sum()
-        x = c.local - w @ c.local
-        lam, vec = np.linalg.eigh((x * w[:, None]).T @ x)
-        M = vec[:, 1]
-        size = np.asarray(now[:2])
-        span_b, span_a = np.abs(M[::-1]) @ size, np.abs(M) @ size
-        # Each cell smears its force over its span (variance span²/12): a patch one cell wide
-        # measures at least that width.
-        b2 = 2.0 * np.sqrt(5.0 * (max(lam[0], 0.0) + span_b**2 / 12.0))
-        a2 = 2.0 * np.sqrt(5.0 * (max(lam[1], 0.0) + span_a**2 / 12.0))
-        ideal = (min(base, b2 / (1.25 * n_across)), min(base, a2 / (1.25 * n_across)))
-        fine = b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_across * span_a
-        wasteful = size[0] * size[1] < 0.4 * ideal[0] * ideal[1]
-        if fine and not wasteful and not remake:
-            new[key] = now
-            continue
-        refine = True
-        turn = math.atan2(M[1], M[0]) - 0.5 * math.pi  # η onto the major axis
-        new[key] = (*ideal, math.remainder(now[2] + turn, math.pi))
-    return new if refine else None
 
 
 def solve_position(
@@ -458,7 +294,7 @@ def solve_position(
         # Grids made for the previous position's measured patches (not merely accepted for
         # them): a grid drifting with a growing or shrinking patch would cross the acceptance
         # bounds and cost a second solve (measured on the seed face gear: 39 -> 34 solves).
-        made = _refined_sizes(previous.cells, previous.solution, cell, models.n_across, True)
+        made = refined_sizes(previous.cells, previous.solution, cell, models.n_across, True)
         cell = made if made is not None else cell
     fps = None
     if previous is not None and previous.cells:
@@ -486,7 +322,7 @@ def solve_position(
     # hybrid: refine the cells until every loaded patch has n_across cells across it in both
     # flank directions; the zone shrinks to where the rigid approach theta h can close it.
     for _ in range(3 if models.fidelity == "hybrid" else 0):
-        sizes = _refined_sizes(cells, sol, cell, models.n_across)
+        sizes = refined_sizes(cells, sol, cell, models.n_across)
         if sizes is None:
             break
         h_all = np.concatenate([c.h for c in cells])
@@ -548,78 +384,4 @@ def solve_position(
         solution=sol,
         g_max_mm=g_max,
         warnings=tuple(warnings),
-    )
-
-
-def run_ltca(
-    pinion,
-    gear,
-    assembly,
-    torque2_Nmm: float,
-    options: LTCAOptions | None = None,
-    phi1: np.ndarray | None = None,
-    models: MemberModels | None = None,
-    progress=None,
-) -> LoadedCycle:
-    """Loaded tooth contact analysis over one mesh cycle (or at the pinion angles ``phi1``).
-
-    Parameters
-    ----------
-    pinion, gear
-        Generated members.
-    assembly
-        The assembled pair (:mod:`fegear.assembly`), with its installation errors.
-    torque2_Nmm
-        Resisting torque on member 2 (N·mm, > 0).
-    options
-        :class:`LTCAOptions`.
-    phi1
-        Pinion angles (rad); default ``n_positions`` over one cycle ``[−π/N1, π/N1)``.
-    models
-        Pre-built member models (to reuse over several torques).
-    progress
-        Optional callable ``progress(i, n)`` called after each position.
-    """
-    if not (np.isfinite(torque2_Nmm) and torque2_Nmm > 0):
-        raise InputError("torque2_Nmm", torque2_Nmm, "a finite number > 0")
-    opt = options or LTCAOptions()
-    seconds: dict[str, float] = {}
-    t0 = time.perf_counter()
-    tca_opt = TCAOptions(
-        n_positions=opt.n_positions, separation_grid=opt.tca_grid, E_MPa=opt.E_MPa, nu=opt.nu
-    )
-    if phi1 is None:
-        n = opt.n_positions
-        phi1 = -np.pi / assembly.n1 + 2 * np.pi / assembly.n1 * np.arange(n) / n
-    phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
-    tca, tca_pos, _ = cached_tca(pinion, gear, assembly, tca_opt, phi1)
-    asm = tca.asm
-    seconds["tca"] = time.perf_counter() - t0
-    if models is None:
-        models = build_models(pinion, gear, asm, opt)
-    seconds["models"] = models.seconds
-    t0 = time.perf_counter()
-    out = []
-    for i, pos in enumerate(tca_pos):
-        if opt.fidelity == "hertz":
-            from fegear.ltca.hertz_model import solve_position_hertz
-
-            out.append(solve_position_hertz(tca, pos, models, torque2_Nmm, opt.E_MPa, opt.nu))
-        else:
-            prev = out[-1] if out else None
-            out.append(solve_position(tca, pos, models, torque2_Nmm, opt.g_max_mm, prev))
-        if progress is not None:
-            progress(i + 1, len(tca_pos))
-    seconds["positions"] = time.perf_counter() - t0
-    return LoadedCycle(
-        positions=tuple(out),
-        torque2_Nmm=float(torque2_Nmm),
-        phi1=phi1,
-        te_unloaded_arcsec=np.array([p.te_unloaded_arcsec for p in out]),
-        te_loaded_arcsec=np.array([p.te_loaded_arcsec for p in out]),
-        n_in_contact=np.array([p.n_pairs_in_contact for p in out], dtype=int),
-        fidelity=opt.fidelity,
-        level=opt.level,
-        seconds=seconds,
-        phase2=float(asm.phase2),
     )

@@ -31,7 +31,13 @@ from fegear.fem.elasticity import ElasticBody, assemble_body, boundary_dofs
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.mesh.sector import SectorMesh
 
-__all__ = ["MemberModel", "build_member_model", "member_load_operator", "member_compliance"]
+__all__ = [
+    "MemberModel",
+    "build_member_model",
+    "member_load_operator",
+    "member_compliance",
+    "cell_load_operators",
+]
 
 log = logging.getLogger(__name__)
 
@@ -95,16 +101,16 @@ def build_member_model(
     body = assemble_body(mesh, E, nu, clamped)
     flanks = [f"flank_{side}_{t}" for t in range(sector.n_teeth)]
     dofs = np.unique(np.concatenate([boundary_dofs(body.basis, f) for f in flanks]))
-    layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
-    if layer_mm > 0.0:
-        layer_tets[_layer_tets(mesh, flanks, layer_mm)] = True
-        dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
         "clamped": clamped,
         "flanks": flanks,
         "layer_mm": layer_mm,
     }
+    layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
+    if layer_mm > 0.0:
+        layer_tets[_cached_layer_tets(mesh, flanks, layer_mm, key)] = True
+        dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
     op = candidate_operator(body, dofs, backend=backend, cache_key=key)
     log.info(
         "%s: %d DOFs, %d candidate DOFs, operator in %.1f s (%s)",
@@ -123,6 +129,18 @@ def build_member_model(
         layer_mm=layer_mm,
         layer_tets=layer_tets,
     )
+
+
+def _cached_layer_tets(mesh, flanks: list[str], depth: float, key: dict) -> np.ndarray:
+    """:func:`_layer_tets`, read from the cache when the same mesh was layered before (0.2 s)."""
+    from fegear.mesh.cache import cached_file
+
+    def build(path) -> None:
+        with open(path, "wb") as fh:
+            np.save(fh, _layer_tets(mesh, flanks, depth))
+
+    path, _ = cached_file("layer", {"kind": "layer_tets_v1", **key}, ".npy", build)
+    return np.load(path)
 
 
 def _layer_tets(mesh, flanks: list[str], depth: float) -> np.ndarray:
@@ -203,3 +221,26 @@ def member_load_operator(
 def member_compliance(model: MemberModel, P: sp.csr_matrix) -> np.ndarray:
     """``C = Pᵀ (K⁻¹) P`` of all cells on this member (cross-tooth coupling included)."""
     return body_compliance(model.op, P)
+
+
+def cell_load_operators(models, M1, M2, cells) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Consistent loads of the contact cells ``cells`` (:class:`~fegear.ltca.grid.PairCells`) on
+    both members (``models.pinion``, ``models.gear`` placed by ``M1``, ``M2``): along ``−n1`` on
+    the pinion flank, along ``+n1`` at the same points moved across the gap onto the gear flank.
+    Returns ``(P1, P2)``, (n_dofs × Σ n) each."""
+    P1 = sp.hstack(
+        [member_load_operator(models.pinion, M1, c.k, c.quad_points, -c.normals) for c in cells]
+    ).tocsr()
+    P2 = sp.hstack(
+        [
+            member_load_operator(
+                models.gear,
+                M2,
+                c.j,
+                c.quad_points + c.gap[:, None, None] * c.normals[:, None],
+                c.normals,
+            )
+            for c in cells
+        ]
+    ).tocsr()
+    return P1, P2

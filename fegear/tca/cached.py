@@ -4,13 +4,14 @@ The unloaded TCA (reference phase + the positions with their separation grids) d
 the two members' design, the assembly (installation errors included), the TCA options and the
 pinion angles, not on the torque or the FE model. A loaded analysis on the same pair (another
 torque, another fidelity or mesh level, a re-run) reads it back instead of solving it again
-(measured on the seed face gear, 25 positions: 2.9 s -> 0.1 s).
+(measured on the seed face gear, 25 positions: 2.9 s -> 0.01 s).
 
 The key holds the members' ``repr`` (their complete design data, as for the sector meshes),
 the assembly's fields, the options, the angles and a hash of the source of the geometry and TCA
 packages, so a change of the code that produces the positions invalidates the entry by itself.
-The entry is a pickle of the :class:`~fegear.tca.results.PositionResult` tuple; it is written
-atomically (:func:`fegear.mesh.cache.cached_file`) and only ever read by the same code version.
+The entry is a pickle of the phase, the :class:`~fegear.tca.results.PositionResult` tuple and
+the TCA's precomputed state (:meth:`~fegear.tca.TCA.state`); it is written atomically
+(:func:`fegear.mesh.cache.cached_file`) and only ever read by the same code version.
 """
 
 from __future__ import annotations
@@ -90,13 +91,14 @@ def cached_tca(
         positions = tuple(tca.positions(phi1))
         box["tca"], box["positions"] = tca, positions
         with open(path, "wb") as fh:
-            pickle.dump((float(asm.phase2), positions), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            entry = (float(asm.phase2), positions, tca.state())
+            pickle.dump(entry, fh, protocol=pickle.HIGHEST_PROTOCOL)
 
     path, hit = cached_file("tca", params, ".pkl", build)
     if not hit:
         return CachedTCA(box["tca"], box["positions"], False)  # type: ignore[arg-type]
     with open(path, "rb") as fh:
-        phase2, positions = pickle.load(fh)
-    tca = TCA(pinion, gear, assembly.with_phase2(phase2), options)
+        phase2, positions, state = pickle.load(fh)
+    tca = TCA.restore(state, assembly.with_phase2(phase2))
     log.info("TCA positions read from the cache (%d)", len(positions))
     return CachedTCA(tca, tuple(positions), True)

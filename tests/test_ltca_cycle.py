@@ -1,0 +1,101 @@
+"""The loaded cycle's driver (fegear.ltca.cycle): positions in chunks, chunks in worker processes.
+
+The chunking is part of the method, the number of workers is not: the same chunks give the same
+numbers in one process or several. Within a chunk a position starts from its predecessor; for
+`fe` that only warm-starts the contact solver, so `fe` does not depend on the chunking either.
+"""
+
+from __future__ import annotations
+
+import pickle
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from fegear.assembly import involute_assembly
+from fegear.errors import InputError
+from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.ltca import LTCAOptions, build_models, run_ltca
+from fegear.ltca.cycle import chunks
+
+PINION = InvoluteMember(
+    InvoluteDesign(16, 4.5, 20, profile_shift=0.1817, face_width_mm=14), "pinion"
+)
+GEAR = InvoluteMember(InvoluteDesign(24, 4.5, 20, profile_shift=0.1715, face_width_mm=14), "gear")
+RATED = 2.0e5  # N·mm on the gear, as in test_ltca.py
+
+
+@pytest.fixture(scope="module")
+def fzg():
+    asm = involute_assembly(PINION, GEAR)
+    opt = LTCAOptions(n_positions=6, level=0, fidelity="hybrid", chunk_positions=3)
+    return asm, opt, build_models(PINION, GEAR, asm, opt)
+
+
+def _numbers(cycle) -> np.ndarray:
+    shares = [[q.load_share for q in p.pairs] for p in cycle.positions]
+    width = max(len(s) for s in shares)
+    padded = np.array([s + [0.0] * (width - len(s)) for s in shares])
+    return np.concatenate([cycle.te_loaded_arcsec, padded.ravel()])
+
+
+@pytest.mark.parametrize(
+    ("n", "size", "lengths"),
+    [(25, 13, [13, 12]), (5, 13, [5]), (7, 1, [1] * 7), (26, 13, [13, 13]), (27, 13, [9, 9, 9])],
+)
+def test_chunks_cover_the_positions_in_order(n: int, size: int, lengths: list[int]) -> None:
+    parts = chunks(n, size)
+    assert [len(r) for r in parts] == lengths
+    assert [i for r in parts for i in r] == list(range(n))
+
+
+def test_the_result_does_not_depend_on_the_number_of_workers(fzg) -> None:
+    asm, opt, models = fzg
+    calls: list[tuple[int, int]] = []
+    runs = [
+        run_ltca(
+            PINION,
+            GEAR,
+            asm,
+            RATED,
+            replace(opt, workers=w),
+            models=models,
+            progress=lambda i, n: calls.append((i, n)),
+        )
+        for w in (1, 2)
+    ]
+    # the same chunks, the same arithmetic; 1e-12: BLAS round-off only (thread count differs)
+    np.testing.assert_allclose(_numbers(runs[0]), _numbers(runs[1]), rtol=1e-12, atol=1e-12)
+    # progress: once per position and run, counting up to n
+    assert calls == [(i, 6) for i in range(1, 7)] * 2
+
+
+def test_fe_does_not_depend_on_the_chunking(fzg) -> None:
+    asm, opt, _ = fzg
+    fe = replace(opt, fidelity="fe", workers=1)
+    models = build_models(PINION, GEAR, asm, fe)
+    runs = [
+        run_ltca(PINION, GEAR, asm, RATED, replace(fe, chunk_positions=k), models=models)
+        for k in (1, 6)
+    ]
+    # each position's QP has one minimiser; the active-set warm start of a chained position
+    # changes the solver's path only (1e-9: the factorisations' round-off, relative)
+    np.testing.assert_allclose(_numbers(runs[0]), _numbers(runs[1]), rtol=1e-9, atol=1e-9)
+    assert sum(p.solution.iterations for p in runs[1].positions) < sum(
+        p.solution.iterations for p in runs[0].positions
+    )
+
+
+@pytest.mark.parametrize(
+    ("field", "value"), [("workers", 0), ("workers", 1.5), ("chunk_positions", 0)]
+)
+def test_bad_chunking_options_are_refused(field: str, value) -> None:
+    with pytest.raises(InputError) as info:
+        LTCAOptions(**{field: value})
+    assert info.value.field == field
+
+
+def test_typed_errors_survive_the_trip_from_a_worker() -> None:
+    err = pickle.loads(pickle.dumps(InputError("torque2_Nmm", -1.0, "> 0", "detail")))
+    assert type(err) is InputError and err.field == "torque2_Nmm" and "detail" in str(err)
