@@ -477,7 +477,7 @@ def run_item(item: SweepItem, out: str | Path, cache_root: str | None = None) ->
     tmp = out / f".{item.name}.{uuid.uuid4().hex[:8]}.tmp"
     try:
         tmp.mkdir(parents=True)
-        run = run_gear_case(item.case)
+        run = run_gear_case(item.case, workers=1)  # the sweep runs its items in parallel
         write_gear_outputs(tmp, run)
         seconds = time.perf_counter() - t0
         write_json(

@@ -221,6 +221,7 @@ def run_gear_case(
     level: int | None = None,
     progress: Progress | None = None,
     pair: GearPair | None = None,
+    workers: int | None = None,
 ) -> GearRun:
     """Run a gear case at its (or the given) fidelity and level.
 
@@ -236,6 +237,9 @@ def run_gear_case(
     pair
         The pair of the case if already built (:func:`~fegear.io.gear_case.build_pair`, which
         is where bad design data is refused).
+    workers
+        Processes for the mesh positions (:mod:`fegear.ltca.cycle`); None: one per core. A
+        sweep, which runs its items in parallel already, passes 1.
 
     Raises
     ------
@@ -271,6 +275,7 @@ def run_gear_case(
         nu=case.nu,
         backend=case.backend,
         fidelity=case.fidelity,
+        workers=workers,
     )
     t0 = time.perf_counter()
     say("models", None, None)

@@ -72,10 +72,12 @@ def _worker_init(threads: int) -> None:
     """In a forked worker: its share of the cores, for the threaded half-space evaluation and for
     BLAS. OpenBLAS threads left at the core count in every worker (they spin while waiting for
     work) made the two workers of the seed face gear 1.6-3x slower, erratically (measured)."""
-    from threadpoolctl import threadpool_limits
+    from threadpoolctl import ThreadpoolController
 
     os.environ["FEGEAR_THREADS"] = str(threads)
-    threadpool_limits(limits=threads)  # held for the worker's lifetime
+    # OpenBLAS only (numpy's and SciPy's BLAS): MKL and its OpenMP runtime, used by the parent
+    # for the operators, are not touched in a forked child. Held for the worker's lifetime.
+    ThreadpoolController().select(internal_api="openblas").limit(limits=threads)
 
 
 def _workers(requested: int | None, n_chunks: int) -> int:

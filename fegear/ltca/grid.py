@@ -189,6 +189,12 @@ def pair_cells(
     V_near = np.clip(g.v[iv][:, None] + dv_c * corner_v, b.v_start, b.v_end)
     xe = np.einsum("ij,jnk->ink", Ainv, np.stack([U_near - uc, V_near - vc]))
     lo, hi = xe.reshape(2, -1).min(axis=1), xe.reshape(2, -1).max(axis=1)
+    # Never evaluate more than 16 max_cells grid points: fine cells over a large zone would
+    # (47 million points, 24 GB, were asked for once); the kept cells are capped below anyway.
+    n_box = ((hi[0] - lo[0]) / cu_mm + 2.0) * ((hi[1] - lo[1]) / cv_mm + 2.0)
+    if n_box > 16 * max_cells:
+        f = math.sqrt(n_box / (16 * max_cells))
+        cu_mm, cv_mm = cu_mm * f, cv_mm * f
     for _ in range(3):
         cx, cy = _centres(lo[0], hi[0], cu_mm), _centres(lo[1], hi[1], cv_mm)
         XI, ETA = np.meshgrid(cx, cy, indexing="ij")

@@ -145,7 +145,7 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     """
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
-    idle = []
+    idle, heaviest = [], None
     for c in cells:
         F = sol.force[start : start + c.n]
         start += c.n
@@ -154,6 +154,8 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
         if not np.any(F > 0):
             idle.append((key, now))
             continue
+        if heaviest is None or F.sum() > heaviest[0]:
+            heaviest = (float(F.sum()), key)
         w = F / F.sum()
         x = c.local - w @ c.local
         lam, vec = np.linalg.eigh((x * w[:, None]).T @ x)
@@ -177,10 +179,11 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     # have missed its contact: its separation valley (as narrow as the patches) can fall between
     # the centres of coarse cells (measured on the seed face gear: a 2.9 mm cell read 0.019 mm
     # where the valley is 0.0033 mm deep, and the pair, which carries 25 % of the torque, was
-    # lost). It gets the finest loaded pair's grid.
-    loaded = [v for k, v in new.items() if k is not None]
-    if idle and loaded:
-        ref = min(loaded, key=lambda v: v[0] * v[1])
+    # lost). It gets the grid of the pair carrying the most load (not the finest grid: that is
+    # usually an edge contact's, and spread over an idle pair's whole zone it made 47 million
+    # cells on the face gear at level 1).
+    if idle and heaviest is not None:
+        ref = new[heaviest[1]]
         for key, now in idle:
             if now[0] * now[1] > 4.0 * ref[0] * ref[1]:
                 new[key], refine = ref, True
