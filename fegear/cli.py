@@ -56,6 +56,12 @@ def _parser() -> argparse.ArgumentParser:
         "tca (unloaded, rigid); "
         "Hertz scene: fe | hybrid (coarse FE + half-space near field)",
     )
+    r.add_argument(
+        "--workers",
+        type=int,
+        help="gear pairs: processes solving the mesh positions (default: one per core); the "
+        "result does not depend on it",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     s = sub.add_parser(
         "sweep",
@@ -118,6 +124,8 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         raise InputError("--fidelity", fid, "'fe', 'hertz', 'hybrid' or 'tca' for gear pairs")
     if not 0 <= lvl <= 4:
         raise InputError("--level", lvl, "an integer in [0, 4]")
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", args.workers, "an integer >= 1")
     t_start = time.perf_counter()
     pair = build_pair(case)  # bad design data is refused here, before any output
     say(
@@ -161,7 +169,12 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         stage_t["t"] = now
 
     run = run_gear_case(
-        case, fidelity=args.fidelity, level=args.level, progress=progress, pair=pair
+        case,
+        fidelity=args.fidelity,
+        level=args.level,
+        progress=progress,
+        pair=pair,
+        workers=args.workers,
     )
     progress("writing", None, None)
     paths = write_gear_outputs(out, run)

@@ -448,7 +448,9 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {msg}"
 
 
-def run_item(item: SweepItem, out: str | Path, cache_root: str | None = None) -> ItemResult:
+def run_item(
+    item: SweepItem, out: str | Path, cache_root: str | None = None, position_workers: int = 1
+) -> ItemResult:
     """Run one item into ``out/<item.name>/`` atomically (the worker's entry point).
 
     Never raises for a failure of the analysis: the result carries the one-line error. An item
@@ -462,6 +464,9 @@ def run_item(item: SweepItem, out: str | Path, cache_root: str | None = None) ->
         The sweep folder (absolute on a cluster).
     cache_root
         Mesh/operator cache folder (``$FEGEAR_CACHE``) to use in this worker.
+    position_workers
+        Processes for the item's mesh positions (:mod:`fegear.ltca.cycle`): the cores left to
+        each item by the sweep's own workers (1 on a Dask cluster).
     """
     from fegear.io.files import write_json
     from fegear.io.gear_output import write_gear_outputs
@@ -477,7 +482,7 @@ def run_item(item: SweepItem, out: str | Path, cache_root: str | None = None) ->
     tmp = out / f".{item.name}.{uuid.uuid4().hex[:8]}.tmp"
     try:
         tmp.mkdir(parents=True)
-        run = run_gear_case(item.case, workers=1)  # the sweep runs its items in parallel
+        run = run_gear_case(item.case, workers=position_workers)
         write_gear_outputs(tmp, run)
         seconds = time.perf_counter() - t0
         write_json(
@@ -673,10 +678,12 @@ def _execute(
         finally:
             client.close()
         return
-    pool = _local_pool(min(workers, len(todo)))
+    n_pool = min(workers, len(todo))
+    pool = _local_pool(n_pool)
+    per_item = max(1, (os.cpu_count() or 1) // n_pool)  # the cores each item may use
     try:
         futures: dict[Future, SweepItem] = {
-            pool.submit(run_item, it, str(out), cache_root): it for it in todo
+            pool.submit(run_item, it, str(out), cache_root, per_item): it for it in todo
         }
         for fut in as_completed(futures):
             it = futures[fut]

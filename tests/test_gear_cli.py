@@ -175,6 +175,7 @@ def test_malformed_gear_case_is_refused_with_one_line(tmp_path, capsys, text, wo
         (["--level", "9"], "--level"),
         (["--fidelity", "exact"], "--fidelity"),
         (["--study", "0,1"], "--study"),
+        (["--workers", "0"], "--workers"),
     ],
 )
 def test_bad_command_line_values_for_a_gear_case(tmp_path, capsys, argv, word):

@@ -31,6 +31,8 @@ __all__ = ["PairCells", "pair_cells"]
 
 Array = NDArray[np.float64]
 _GAUSS2 = np.array([-1.0, 1.0]) / math.sqrt(3.0)
+#: Grid points evaluated at most, in units of ``max_cells`` (see :func:`pair_cells`).
+_PRECAP = 16
 
 
 @dataclass(frozen=True)
@@ -192,8 +194,8 @@ def pair_cells(
     # Never evaluate more than 16 max_cells grid points: fine cells over a large zone would
     # (47 million points, 24 GB, were asked for once); the kept cells are capped below anyway.
     n_box = ((hi[0] - lo[0]) / cu_mm + 2.0) * ((hi[1] - lo[1]) / cv_mm + 2.0)
-    if n_box > 16 * max_cells:
-        f = math.sqrt(n_box / (16 * max_cells))
+    if n_box > _PRECAP * max_cells:
+        f = math.sqrt(n_box / (_PRECAP * max_cells))
         cu_mm, cv_mm = cu_mm * f, cv_mm * f
     for _ in range(3):
         cx, cy = _centres(lo[0], hi[0], cu_mm), _centres(lo[1], hi[1], cv_mm)
