@@ -99,3 +99,22 @@ def test_bad_chunking_options_are_refused(field: str, value) -> None:
 def test_typed_errors_survive_the_trip_from_a_worker() -> None:
     err = pickle.loads(pickle.dumps(InputError("torque2_Nmm", -1.0, "> 0", "detail")))
     assert type(err) is InputError and err.field == "torque2_Nmm" and "detail" in str(err)
+
+
+def _die(r, job=None):
+    """A worker's chunk that is killed (as by the OOM killer)."""
+    import os
+    import signal
+
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def test_a_dying_worker_is_a_solver_error(fzg, monkeypatch) -> None:
+    """A worker killed mid-chunk (the OOM killer, say) is reported as a typed error."""
+    import fegear.ltca.cycle as cycle
+    from fegear.errors import SolverError
+
+    asm, opt, models = fzg
+    monkeypatch.setattr(cycle, "_solve_chunk", _die)
+    with pytest.raises(SolverError, match="worker"):
+        run_ltca(PINION, GEAR, asm, RATED, replace(opt, workers=2), models=models)

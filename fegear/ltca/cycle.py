@@ -22,10 +22,11 @@ import os
 import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from fegear.errors import InputError
+from fegear.errors import InputError, SolverError
 from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, solve_position
 from fegear.ltca.results import LoadedCycle, LoadedPosition
 from fegear.tca import TCAOptions
@@ -128,6 +129,11 @@ def _solve_all(job: dict[str, object], parts: list[range], workers: int, progres
                     if progress is not None:
                         progress(k, n)
             return [p for f in futures for p in f.result()]
+    except BrokenProcessPool as exc:
+        raise SolverError(
+            "a worker solving mesh positions died (out of memory?); "
+            "re-run with workers=1 (CLI: --workers 1) to see the error in this process"
+        ) from exc
     finally:
         _JOB.clear()
 
