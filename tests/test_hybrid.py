@@ -158,29 +158,32 @@ def test_an_idle_pair_on_coarse_cells_gets_the_loaded_pairs_grid():
             assert new is None
 
 
+def _face_gear_cycle(options, phi1=None):
+    """The seed face gear's loaded cycle (the case file's pair and torque) with ``options``."""
+    from pathlib import Path
+
+    from fegear.case import load_case
+    from fegear.io.gear_case import build_pair
+    from fegear.ltca import run_ltca
+
+    case = load_case(Path(__file__).parents[1] / "cases" / "face_gear_nominal.toml")
+    pair = build_pair(case)
+    return run_ltca(pair.pinion, pair.gear, pair.assembly, case.torque2_Nmm, options, phi1=phi1)
+
+
 @pytest.mark.slow
 def test_face_gear_position_solved_cold_matches_the_warm_chain():
     """Seed face gear, hybrid level 0, position 13 of 25 (two pairs share the load): solved from
     the default cells (a chunk start) and from the chain of its predecessors. Regression: the
     coarse first cells missed pair (0, 0)'s 0.6 mm wide separation valley, the pair was never
     refined and dropped (TE -4.21" instead of -3.47"; now -3.479" vs -3.472")."""
-    from pathlib import Path
+    from fegear.ltca import LTCAOptions
 
-    from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
-    from fegear.ltca import LTCAOptions, run_ltca
-
-    case = load_case(Path(__file__).parents[1] / "cases" / "face_gear_nominal.toml")
-    pair = build_pair(case)
-    phi1 = -np.pi / pair.assembly.n1 + 2 * np.pi / pair.assembly.n1 * np.arange(25) / 25
+    phi1 = -np.pi / 25 + 2 * np.pi / 25 * np.arange(25) / 25  # the pinion's 25 teeth, 25 positions
     runs = [
-        run_ltca(
-            pair.pinion,
-            pair.gear,
-            pair.assembly,
-            case.torque2_Nmm,
+        _face_gear_cycle(
             LTCAOptions(fidelity="hybrid", chunk_positions=size, workers=1),
-            phi1=phi1[10:14] if size > 1 else phi1[13:14],
+            phi1[10:14] if size > 1 else phi1[13:14],
         )
         for size in (4, 1)
     ]
@@ -199,24 +202,9 @@ def test_face_gear_hybrid_is_converged_in_the_fe_level():
 
     Measured (benchmarks/results/fidelity_face_gear.md): shares within 0.016, TE p-p 2 %, mean
     TE 3 %, interior p_max 2 % — where `fe` levels 0-3 still move (contact ratio 1.20 -> 1.36)."""
-    from pathlib import Path
+    from fegear.ltca import LTCAOptions
 
-    from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
-    from fegear.ltca import LTCAOptions, run_ltca
-
-    case = load_case(Path(__file__).parents[1] / "cases" / "face_gear_nominal.toml")
-    pair = build_pair(case)
-    runs = [
-        run_ltca(
-            pair.pinion,
-            pair.gear,
-            pair.assembly,
-            case.torque2_Nmm,
-            LTCAOptions(level=lv, fidelity="hybrid"),
-        )  # fmt: skip
-        for lv in (0, 1)
-    ]
+    runs = [_face_gear_cycle(LTCAOptions(level=lv, fidelity="hybrid")) for lv in (0, 1)]
     share = [
         np.array([sum(q.load_share for q in p.pairs if (q.k, q.j) == (0, 0)) for p in c.positions])
         for c in runs
