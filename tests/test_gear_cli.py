@@ -431,8 +431,9 @@ def test_fzg_hertz_fidelity_runs_from_the_command_line(tmp_path):
 
 def test_fzg_hybrid_fidelity_runs_from_the_command_line(tmp_path):
     out = tmp_path / "hybrid"
-    argv = ["run", str(FZG), "--fidelity", "hybrid", "--out", str(out), "-q"]
+    argv = ["run", str(FZG), "--fidelity", "hybrid", "--out", str(out), "-q", "--workers", "1"]
     assert main(argv) == 0
     doc = json.loads((out / "summary.json").read_text())
     assert doc["cycle"]["max_equilibrium_residual"] < 1e-9  # the solver balances the torque
+    assert doc["fidelity"] == "hybrid" and doc["level"] == 0  # the FE level under the hybrid
     assert (out / "cycle.pvd").is_file()

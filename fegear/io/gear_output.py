@@ -155,7 +155,7 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
         "case": case.name,
         "kind": case.kind,
         "fidelity": case.fidelity,
-        "level": case.level if case.fidelity == "fe" else None,
+        "level": None if case.fidelity == "tca" else case.level,  # the FE level of fe/hybrid/hertz
         "units": UNITS,
         "conventions": {
             "te": "TE = (phi2 - phi2_0) - (N1/N2)(phi1 - phi1_0) on member 2; negative: lag",
