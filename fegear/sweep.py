@@ -449,7 +449,10 @@ def _one_line(exc: BaseException) -> str:
 
 
 def run_item(
-    item: SweepItem, out: str | Path, cache_root: str | None = None, position_workers: int = 1
+    item: SweepItem,
+    out: str | Path,
+    cache_root: str | None = None,
+    position_workers: int | None = 1,
 ) -> ItemResult:
     """Run one item into ``out/<item.name>/`` atomically (the worker's entry point).
 
@@ -466,7 +469,8 @@ def run_item(
         Mesh/operator cache folder (``$FEGEAR_CACHE``) to use in this worker.
     position_workers
         Processes for the item's mesh positions (:mod:`fegear.ltca.cycle`): the cores left to
-        each item by the sweep's own workers (1 on a Dask cluster).
+        each item by the sweep's own workers (1 on a Dask cluster; None: ``$FEGEAR_WORKERS``
+        or one per core).
     """
     from fegear.io.files import write_json
     from fegear.io.gear_output import write_gear_outputs
@@ -680,7 +684,8 @@ def _execute(
         return
     n_pool = min(workers, len(todo))
     pool = _local_pool(n_pool)
-    per_item = max(1, (os.cpu_count() or 1) // n_pool)  # the cores each item may use
+    # the cores each item may use ($FEGEAR_WORKERS, if set, decides in the item's process)
+    per_item = None if os.environ.get("FEGEAR_WORKERS") else max(1, (os.cpu_count() or 1) // n_pool)
     try:
         futures: dict[Future, SweepItem] = {
             pool.submit(run_item, it, str(out), cache_root, per_item): it for it in todo

@@ -10,6 +10,9 @@ import os
 # any test module; an explicit setting in the environment wins. MKL (PARDISO) is left alone: it
 # takes its own thread count (fegear.linalg.schur: MKL_NUM_THREADS, else 2).
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# Mesh positions in this process unless a test asks for worker processes (tests/test_ltca_cycle.py
+# checks that the worker count does not change the result): fewer forks of the test session.
+os.environ.setdefault("FEGEAR_WORKERS", "1")
 
 import pytest  # noqa: E402
 

@@ -11,7 +11,8 @@ worker or eight (``tests/test_ltca_cycle.py``). Measured on the seed face gear, 
 0, 25 positions, 2 cores: positions 4.5 s in one process, 2.3 s in two (chunks of 13 and 12).
 
 Where a process cannot fork (no ``fork`` start method, or a daemon process such as a Dask worker),
-the chunks run one after the other in the calling process.
+the chunks run one after the other in the calling process. ``$FEGEAR_WORKERS`` sets the default
+worker count (the test suite runs with 1 and forks only where a test asks for workers).
 """
 
 from __future__ import annotations
@@ -84,6 +85,15 @@ def _worker_init(threads: int) -> None:
 def _workers(requested: int | None, n_chunks: int) -> int:
     if requested is not None and requested < 1:
         raise InputError("workers", requested, "an integer >= 1, or None for all cores")
+    if requested is None and os.environ.get("FEGEAR_WORKERS", "").strip():
+        try:
+            requested = int(os.environ["FEGEAR_WORKERS"])
+        except ValueError:
+            raise InputError(
+                "FEGEAR_WORKERS", os.environ["FEGEAR_WORKERS"], "an integer >= 1"
+            ) from None
+        if requested < 1:
+            raise InputError("FEGEAR_WORKERS", requested, "an integer >= 1")
     want = requested if requested is not None else (os.cpu_count() or 1)
     want = min(want, n_chunks)
     if want > 1 and (
