@@ -8,6 +8,7 @@ spiral bevel pinion and gear run under ``-m slow`` (the bevel pair design alone 
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -165,3 +166,33 @@ def test_zone_and_inputs():
         sector_mesh(m, level=7)
     with pytest.raises(InputError):
         sector_mesh(m, zone=[FlankZone(5, "drive", (3.0, 6.0), (-2.0, 2.0))])
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc (Linux)")
+def test_gmsh_leaves_sigpipe_ignored():
+    """gmsh.initialize() resets SIGPIPE to 'terminate'; after it a write to a closed pipe (a
+    worker process that died) killed the whole process silently (exit 141, seen as a CI run
+    that stopped after 529 tests). fegear's gmsh start puts Python's 'ignore' back."""
+    import gmsh
+
+    from fegear.mesh.gmsh_session import initialize
+
+    def sigpipe_ignored() -> bool:
+        line = next(x for x in Path("/proc/self/status").read_text().splitlines()
+                    if x.startswith("SigIgn"))  # fmt: skip
+        return bool(int(line.split()[1], 16) & (1 << (13 - 1)))
+
+    import signal
+
+    assert sigpipe_ignored()  # Python's default
+    gmsh.initialize(interruptible=False)  # the bare call: what the helper guards against
+    bare = sigpipe_ignored()
+    gmsh.finalize()
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    assert not bare, "gmsh no longer resets SIGPIPE: fegear.mesh.gmsh_session can go"
+    initialize()
+    try:
+        assert sigpipe_ignored()
+    finally:
+        gmsh.finalize()
+    assert sigpipe_ignored()

@@ -37,6 +37,7 @@ from skfem.io.meshio import from_meshio
 
 from fegear.errors import InputError, MeshError
 from fegear.mesh.cache import cached_file
+from fegear.mesh.gmsh_session import initialize as initialize_gmsh
 
 __all__ = ["BodyMeshSpec", "mesh_block", "mesh_roller", "read_tet_mesh", "roller_height"]
 
@@ -87,7 +88,7 @@ def roller_height(x: np.ndarray, y: np.ndarray, Rx: float, Ry: float) -> np.ndar
 def _init(name: str) -> None:
     import gmsh
 
-    gmsh.initialize(interruptible=False)
+    initialize_gmsh()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.option.setNumber("General.NumThreads", 1)  # deterministic meshes (HXT is parallel)
     gmsh.model.add(name)

@@ -64,6 +64,7 @@ from numpy.typing import NDArray
 from ..errors import InputError, MeshError
 from ..geometry.surface import GeneratedMember, Side
 from .cache import cache_dir, cached_file, content_hash
+from .gmsh_session import initialize as initialize_gmsh
 from .sector_geometry import (
     SectorFrame,
     flank_distance,
@@ -343,7 +344,7 @@ def _attempt(
     h_fine, h_coarse = mesh_sizes(fr.module, level)
     diag: dict[str, object] = {"h_fine_mm": h_fine, "h_coarse_mm": h_coarse}
     t0 = time.perf_counter()
-    gmsh.initialize(interruptible=False)
+    initialize_gmsh()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 2)
