@@ -168,31 +168,33 @@ def test_zone_and_inputs():
         sector_mesh(m, zone=[FlankZone(5, "drive", (3.0, 6.0), (-2.0, 2.0))])
 
 
+_SIGPIPE_CHECK = """
+import sys
+from pathlib import Path
+import gmsh
+from fegear.mesh.gmsh_session import initialize
+def ignored():
+    status = Path("/proc/self/status").read_text().splitlines()
+    line = next(x for x in status if x.startswith("SigIgn"))
+    return bool(int(line.split()[1], 16) & (1 << 12))  # bit 13 - 1: SIGPIPE
+before = ignored()
+gmsh.initialize(interruptible=False) if sys.argv[1] == "bare" else initialize()
+print(before, ignored())
+gmsh.finalize()
+"""
+
+
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc (Linux)")
-def test_gmsh_leaves_sigpipe_ignored():
-    """gmsh.initialize() resets SIGPIPE to 'terminate'; after it a write to a closed pipe (a
-    worker process that died) killed the whole process silently (exit 141, seen as a CI run
-    that stopped after 529 tests). fegear's gmsh start puts Python's 'ignore' back."""
-    import gmsh
+@pytest.mark.parametrize(("start", "kept"), [("bare", False), ("fegear", True)])
+def test_gmsh_leaves_sigpipe_ignored(start: str, kept: bool):
+    """gmsh's first initialize() in a process resets SIGPIPE to 'terminate'; after it a write to
+    a closed pipe (a worker process that died) killed the whole process silently (exit 141, seen
+    as CI runs that stopped after 529 tests). fegear's gmsh start puts Python's 'ignore' back.
+    Each case in a fresh interpreter: only the first initialize() does it."""
+    import subprocess
+    import sys
 
-    from fegear.mesh.gmsh_session import initialize
-
-    def sigpipe_ignored() -> bool:
-        line = next(x for x in Path("/proc/self/status").read_text().splitlines()
-                    if x.startswith("SigIgn"))  # fmt: skip
-        return bool(int(line.split()[1], 16) & (1 << (13 - 1)))
-
-    import signal
-
-    assert sigpipe_ignored()  # Python's default
-    gmsh.initialize(interruptible=False)  # the bare call: what the helper guards against
-    bare = sigpipe_ignored()
-    gmsh.finalize()
-    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
-    assert not bare, "gmsh no longer resets SIGPIPE: fegear.mesh.gmsh_session can go"
-    initialize()
-    try:
-        assert sigpipe_ignored()
-    finally:
-        gmsh.finalize()
-    assert sigpipe_ignored()
+    out = subprocess.run(
+        [sys.executable, "-c", _SIGPIPE_CHECK, start], capture_output=True, text=True, check=True
+    ).stdout.split()
+    assert out == ["True", str(kept)], out
