@@ -539,11 +539,18 @@ def _lock(out: Path) -> Iterator[None]:
 
 
 def _clean_tmp(out: Path) -> list[str]:
-    """Remove the ``.*.tmp`` folders of an interrupted run; returns their names."""
+    """Remove the ``.*.tmp`` folders of an interrupted run, and the temporary files of its
+    interrupted atomic writes (``.sweep.<random>.json`` and the like, left when the run was
+    killed between writing and renaming; the caller holds the sweep's lock, so no writer is
+    alive); returns their names."""
     gone = []
     for p in out.glob(".*.tmp"):
         if p.is_dir():
             _rmtree(p)
+            gone.append(p.name)
+    for p in out.glob(".*.*"):
+        if p.is_file() and p.name != ".sweep.lock":
+            p.unlink()
             gone.append(p.name)
     return gone
 
