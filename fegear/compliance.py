@@ -42,7 +42,7 @@ from scipy.spatial import cKDTree
 
 from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody
-from fegear.linalg import inverse_block, resolve_backend
+from fegear.linalg import inverse_block, requested_backend, resolve_backend
 from fegear.mesh.cache import cached_file
 
 __all__ = [
@@ -329,6 +329,7 @@ def candidate_operator(
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     pos = np.searchsorted(body.free, c)
     t0 = time.perf_counter()
+    requested_backend(backend)  # a bad name is refused on a cache hit too
     used = ""
 
     def compute() -> np.ndarray:

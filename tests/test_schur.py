@@ -271,3 +271,25 @@ def test_mkl_dense_spd_inverse_refuses_an_indefinite_matrix() -> None:
     S = np.diag([1.0, 2.0, -1.0, 3.0])
     with pytest.raises(SolverError, match="not positive definite"):
         lib.spd_inverse(S)
+
+
+def test_a_bad_backend_name_is_refused_on_an_operator_cache_hit(tmp_path, monkeypatch) -> None:
+    """The operator cache skips the solver (and MKL's loading), not the check of the request."""
+    import skfem
+
+    from fegear.compliance import candidate_operator
+    from fegear.fem.elasticity import assemble_body
+
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path))
+    mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 3)] * 3).with_boundaries(
+        {"bottom": lambda x: x[2] < 1e-9}
+    )
+    body = assemble_body(mesh, 206000.0, 0.3, [("bottom", "xyz")])
+    dofs = body.free[-12:]
+    key = {"mesh": "unit cube 2x2x2", "clamped": "bottom"}
+    first = candidate_operator(body, dofs, "superlu", cache_key=key)
+    again = candidate_operator(body, dofs, "superlu", cache_key=key)
+    assert not first.cache_hit and again.cache_hit
+    np.testing.assert_array_equal(np.asarray(again.G), first.G)  # read back bit for bit
+    with pytest.raises(InputError, match="backend"):
+        candidate_operator(body, dofs, "mumps", cache_key=key)

@@ -11,6 +11,7 @@ from fegear.linalg.schur import (
     ENV_SOLVER,
     available_backends,
     inverse_block,
+    requested_backend,
     resolve_backend,
     schur_complement,
 )
@@ -20,6 +21,7 @@ __all__ = [
     "ENV_SOLVER",
     "available_backends",
     "inverse_block",
+    "requested_backend",
     "resolve_backend",
     "schur_complement",
 ]

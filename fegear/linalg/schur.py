@@ -67,6 +67,7 @@ __all__ = [
     "BACKENDS",
     "ENV_SOLVER",
     "available_backends",
+    "requested_backend",
     "resolve_backend",
     "schur_complement",
     "inverse_block",
@@ -151,6 +152,20 @@ def _check_name(field: str, name: object) -> str:
     return name.strip().lower()
 
 
+def requested_backend(name: str = "auto") -> str:
+    """The backend asked for: ``name`` or, for ``"auto"``, ``FEGEAR_SOLVER`` if set; validated
+    (:class:`InputError` for an unknown name) without loading any library. Returns ``"auto"``,
+    ``"pardiso"`` or ``"superlu"``."""
+    choice = _check_name("backend", name)
+    if choice == "auto":
+        env = os.environ.get(ENV_SOLVER, "").strip()
+        if env:
+            choice = _check_name(ENV_SOLVER, env)
+            if choice != "auto":
+                logger.info("Sparse direct solver: %s (from %s)", choice, ENV_SOLVER)
+    return choice
+
+
 def resolve_backend(name: str = "auto") -> str:
     """Turn a backend request into the concrete backend to use.
 
@@ -173,13 +188,7 @@ def resolve_backend(name: str = "auto") -> str:
         ``"pardiso"`` was asked for explicitly (argument or environment) but MKL PARDISO cannot be
         loaded or fails its self-check.
     """
-    choice = _check_name("backend", name)
-    if choice == "auto":
-        env = os.environ.get(ENV_SOLVER, "").strip()
-        if env:
-            choice = _check_name(ENV_SOLVER, env)
-            if choice != "auto":
-                logger.info("Sparse direct solver: %s (from %s)", choice, ENV_SOLVER)
+    choice = requested_backend(name)
     if choice == "superlu":
         return "superlu"
     lib, reason = _pardiso()

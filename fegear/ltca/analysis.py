@@ -276,9 +276,10 @@ def solve_position(
 ) -> LoadedPosition:
     """Loaded contact at one TCA position (see the module docstring).
 
-    ``previous`` (``hybrid``): the solution at the neighbouring position; its refined cell grids
-    and ``g_max`` start this one (the patches move little from one position to the next, so the
-    first solve is usually already fine enough: one or two solves instead of three or four).
+    ``previous``: the solution at the neighbouring position. Every fidelity starts the contact
+    solver from its active set (:mod:`fegear.ltca.warm`; the answer does not depend on it);
+    ``hybrid`` also starts from its refined cell grids and ``g_max`` (the patches move little
+    from one position to the next: one or two solves instead of three or four).
     """
     if not pos.has_contact:
         return _no_contact(pos, "no contact: the flanks do not meet at this position")

@@ -17,6 +17,7 @@ worker count (the test suite runs with 1 and forks only where a test asks for wo
 
 from __future__ import annotations
 
+import itertools
 import logging
 import multiprocessing
 import os
@@ -24,6 +25,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -83,17 +85,13 @@ def _worker_init(threads: int) -> None:
 
 
 def _workers(requested: int | None, n_chunks: int) -> int:
-    if requested is not None and requested < 1:
-        raise InputError("workers", requested, "an integer >= 1, or None for all cores")
-    if requested is None and os.environ.get("FEGEAR_WORKERS", "").strip():
-        try:
-            requested = int(os.environ["FEGEAR_WORKERS"])
-        except ValueError:
-            raise InputError(
-                "FEGEAR_WORKERS", os.environ["FEGEAR_WORKERS"], "an integer >= 1"
-            ) from None
-        if requested < 1:
-            raise InputError("FEGEAR_WORKERS", requested, "an integer >= 1")
+    """Processes for ``n_chunks`` chunks: ``requested`` (validated by LTCAOptions), else
+    ``$FEGEAR_WORKERS``, else one per core; 1 where this process cannot fork."""
+    env = os.environ.get("FEGEAR_WORKERS", "").strip()
+    if requested is None and env:
+        if not (env.isdigit() and int(env) >= 1):
+            raise InputError("FEGEAR_WORKERS", env, "an integer >= 1")
+        requested = int(env)
     want = requested if requested is not None else (os.cpu_count() or 1)
     want = min(want, n_chunks)
     if want > 1 and (
@@ -108,18 +106,9 @@ def _workers(requested: int | None, n_chunks: int) -> int:
 def _solve_all(job: dict[str, object], parts: list[range], workers: int, progress) -> list:
     n = sum(len(r) for r in parts)
     if workers == 1:
-
-        class _Count:
-            def __init__(self) -> None:
-                self.k = 0
-
-            def put(self, _i: int) -> None:
-                self.k += 1
-                if progress is not None:
-                    progress(self.k, n)
-
-        count = _Count()
-        return [p for r in parts for p in _solve_chunk(r, {**job, "done": count})]
+        finished = itertools.count(1)
+        done = SimpleNamespace(put=lambda _i: progress and progress(next(finished), n))
+        return [p for r in parts for p in _solve_chunk(r, {**job, "done": done})]
     ctx = multiprocessing.get_context("fork")
     done = ctx.SimpleQueue()
     _JOB.clear()
