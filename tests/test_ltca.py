@@ -1,9 +1,10 @@
 """Loaded tooth contact analysis of the FZG type C spur pair (DESIGN §4, §8; issue 6).
 
-FE sectors of 3 teeth at mesh level 0, TCA gaps, torque-balanced active-set contact. The
-invariants hold exactly (the solver enforces them); the load-sharing pattern of an unmodified
-spur pair is the textbook one: one pair carries everything in the single-contact zone, two share
-it in the double-contact zones. The number of pairs in contact is never an input.
+FE sectors of 5 teeth (the 3 that can touch + a neighbour each side) at mesh level 0, TCA gaps,
+torque-balanced active-set contact. The invariants hold exactly (the solver enforces them); the
+load-sharing pattern of an unmodified spur pair is the textbook one: one pair carries everything
+in the single-contact zone, two share it in the double-contact zones. The number of pairs in
+contact is never an input.
 """
 
 from __future__ import annotations
@@ -183,9 +184,11 @@ def test_hertz_fidelity_balances_and_agrees_with_fe_on_load_sharing(setup, cycle
         share_h = {(q.k, q.j): q.load_share for q in p_h.pairs}
         for q in p_f.pairs:
             # both models share the FE body compliance; they differ in the local contact law
-            # (Palmgren line law vs FE cells one element wide): shares within 0.05 (measured
-            # up to 0.046 at level 0)
-            assert abs(share_h.get((q.k, q.j), 0.0) - q.load_share) < 0.05
+            # (Palmgren line law vs FE cells one element wide). Measured on 5-tooth sectors:
+            # up to 0.051 at level 0, 0.050 at 1, 0.036 at 2, where the incoming pair enters
+            # (both move towards `hybrid`: hybrid-fe 0.023 -> 0.015, hybrid-hertz 0.039 ->
+            # 0.021); 0.06 bounds level 0. (3-tooth sectors, centre tooth fine only: 0.046.)
+            assert abs(share_h.get((q.k, q.j), 0.0) - q.load_share) < 0.06
     # the loaded TE of both is a lag of the same order (measured: hertz 17-25 % larger, the
     # FE at level 0 being locally stiff); a factor 1.5 bounds it
     ratio = hz.te_loaded_arcsec / cycle.te_loaded_arcsec
@@ -226,3 +229,37 @@ def test_hybrid_fidelity_resolves_the_contact_width():
     # and about the same elastic lag as `hertz` there (measured -67.71 vs -63.33 arcsec: +6.9 %;
     # 10 %: Palmgren's approach law is empirical and the hybrid lag creeps ~2 % per FE level)
     assert abs(hy.te_loaded_arcsec[0] / hz.te_loaded_arcsec[0] - 1.0) < 0.10
+
+
+def _pitch_jump(asm, models, options) -> tuple[np.ndarray, np.ndarray]:
+    """Loaded TE at two single-contact angles and one pitch later (same contact, next tooth)."""
+    p = 2 * np.pi / PINION.design.n_teeth
+    phi = np.array([-0.4 * p, 0.6 * p, -0.1 * p, 0.9 * p])
+    te = run_ltca(PINION, GEAR, asm, RATED, options, phi1=phi, models=models).te_loaded_arcsec
+    return te[[0, 2]], te[[1, 3]] - te[[0, 2]]
+
+
+def test_loaded_te_repeats_every_pitch(setup):
+    """Periodicity: one pitch later the next tooth pair is in the same contact state, so the loaded
+    TE must repeat. The sector (every pair that can touch plus one unloaded neighbour each side,
+    5 teeth here, all loaded teeth meshed fine) is only approximately periodic: its clamped cuts
+    stiffen the teeth next to them."""
+    asm, models = setup
+    assert models.pinion.sector.n_teeth == 5  # contact ratio 1.46: 3 pairs can touch
+    te, jump = _pitch_jump(asm, models, OPTIONS)
+    # measured 1.97 / 2.06 arcsec of -57 (3.5 %); the 3-tooth sector refined on its centre tooth
+    # only (before the contact zone came from the TCA) gave 12.3 / 13.3 arcsec of -53 (24 %)
+    assert np.all(np.abs(jump) < 0.05 * np.abs(te)), (te, jump)
+
+
+@pytest.mark.slow
+def test_pitch_jump_shrinks_with_the_sector_width(setup):
+    """The periodicity error is the clamped cuts' doing: two more teeth (one each side) must cut
+    it by more than half (measured 2.0 -> 0.7 arcsec, fe level 0)."""
+    from dataclasses import replace
+
+    asm, models = setup
+    _, jump5 = _pitch_jump(asm, models, OPTIONS)
+    wide = replace(OPTIONS, n_teeth=7)
+    _, jump7 = _pitch_jump(asm, build_models(PINION, GEAR, asm, wide), wide)
+    assert np.all(np.abs(jump7) < 0.5 * np.abs(jump5)), (jump5, jump7)

@@ -16,7 +16,8 @@ Schema (``*`` = required)::
                 parallel axes (spur): da_mm, f_sigma_delta_mm, f_sigma_beta_mm, dA1_mm, dA2_mm
                 (all default 0; sign conventions in :mod:`fegear.assembly`)
     [analysis]  fidelity ("fe" | "hertz" | "hybrid" | "tca"), level (0..4), n_positions (>= 2),
-                n_teeth (3..9), backend ("auto" | "pardiso" | "superlu")
+                n_teeth (3..9; default: the teeth that can touch + one neighbour each side),
+                backend ("auto" | "pardiso" | "superlu")
     [material]  E_MPa (> 0), nu (in (-1, 0.5))    — both members
 
 ``[pair]`` by kind:
@@ -171,7 +172,7 @@ class GearCase:
     fidelity: str = "fe"
     level: int = 0
     n_positions: int = 25
-    n_teeth: int = 3
+    n_teeth: int | None = None
     backend: str = "auto"
     E_MPa: float = 206000.0
     nu: float = 0.3
@@ -432,9 +433,9 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     n_pos = ana.get("n_positions", 25)
     if not 2 <= n_pos <= 400:
         raise InputError("analysis.n_positions", n_pos, "an integer in [2, 400]")
-    n_teeth = ana.get("n_teeth", 3)
-    if not 3 <= n_teeth <= 9:
-        raise InputError("analysis.n_teeth", n_teeth, "an integer in [3, 9]")
+    n_teeth = ana.get("n_teeth")
+    if n_teeth is not None and not 3 <= n_teeth <= 9:
+        raise InputError("analysis.n_teeth", n_teeth, "an integer in [3, 9], or absent (automatic)")
     backend = ana.get("backend", "auto")
     if backend not in ("auto", "pardiso", "superlu"):
         raise InputError("analysis.backend", backend, "'auto', 'pardiso' or 'superlu'")
@@ -458,7 +459,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         fidelity=fidelity,
         level=int(level),
         n_positions=int(n_pos),
-        n_teeth=int(n_teeth),
+        n_teeth=None if n_teeth is None else int(n_teeth),
         backend=backend,
         E_MPa=E,
         nu=nu,

@@ -44,7 +44,6 @@ dgamma_deg = 0.0
 fidelity = "fe"
 level = 0
 n_positions = 25
-n_teeth = 3
 
 [material]
 E_MPa = 206000.0

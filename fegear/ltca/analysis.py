@@ -44,17 +44,21 @@ from fegear.ltca.model import (
 )
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.warm import active_guess, footprint
+from fegear.ltca.zone import ContactZone, contact_zone
 from fegear.mesh.sector import FINE, sector_mesh
 from fegear.patch import measure_patch
-from fegear.tca import TCA
+from fegear.tca import TCA, TCAOptions
+from fegear.tca.cached import cached_tca
 from fegear.tca.results import ARCSEC, PositionResult
 
-__all__ = ["LTCAOptions", "MemberModels", "build_models", "solve_position"]
+__all__ = ["LTCAOptions", "MemberModels", "build_models", "cycle_zone", "solve_position"]
 
 log = logging.getLogger(__name__)
 
 # fe: the cells are element-sized, the cap only bounds the dense compliance of a huge zone.
 _FE_MAX_CELLS = 1500
+# The cycle whose TCA gives the contact zone of the sector meshes (cycle_zone).
+_ZONE_POSITIONS = 25
 
 
 @dataclass(frozen=True)
@@ -68,7 +72,9 @@ class LTCAOptions:
     level
         Sector mesh level (0 coarse … 4 fine).
     n_teeth
-        Teeth per sector (contact ratio + one neighbour each side; 3 covers contact ratios < 2).
+        Teeth per sector; None: every tooth that can touch in the cycle plus one unloaded
+        neighbour on each side (:func:`fegear.ltca.zone.contact_zone`; 5 on the seed face gear
+        and the spiral bevel).
     cell_mm
         Contact cell size; None: the fine element size of the coarser member. Cells much
         smaller than the P2 elements make the FE compliance ``PᵀK⁻¹P`` rank-deficient (more
@@ -116,7 +122,7 @@ class LTCAOptions:
 
     n_positions: int = 25
     level: int = 0
-    n_teeth: int = 3
+    n_teeth: int | None = None
     cell_mm: float | None = None
     g_max_mm: float = 0.02
     tca_grid: tuple[int, int] = (24, 12)
@@ -138,6 +144,8 @@ class LTCAOptions:
             raise InputError("chunk_positions", self.chunk_positions, "an integer >= 1")
         if self.workers is not None and not (isinstance(self.workers, int) and self.workers >= 1):
             raise InputError("workers", self.workers, "an integer >= 1, or None for all cores")
+        if self.n_teeth is not None and not (isinstance(self.n_teeth, int) and self.n_teeth >= 1):
+            raise InputError("n_teeth", self.n_teeth, "an integer >= 1, or None (automatic)")
 
 
 @dataclass(frozen=True)
@@ -154,12 +162,44 @@ class MemberModels:
     nu: float = 0.3
     n_across: int = 8
     max_cells: int = 600
+    zone: ContactZone | None = None
 
 
-def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
-    """Mesh both sectors and compute their compliance operators (cached)."""
+def cycle_zone(pinion, gear, assembly, options: LTCAOptions) -> ContactZone:
+    """The contact zone (:func:`fegear.ltca.zone.contact_zone`) of the default cycle of
+    ``_ZONE_POSITIONS`` positions (the TCA comes from its cache), with the separation bound
+    ``g_max`` (where the contact grids start; a position whose ``g_max`` had to grow past it warns
+    if a pair outside the zone could then touch). The zone does not depend on the positions asked
+    for, so every run on the pair shares the meshes."""
+    n = _ZONE_POSITIONS
+    tca_opt = TCAOptions(
+        n_positions=n, separation_grid=options.tca_grid, E_MPa=options.E_MPa, nu=options.nu
+    )
+    phi1 = -np.pi / assembly.n1 + 2 * np.pi / assembly.n1 * np.arange(n) / n
+    tca, positions, _ = cached_tca(pinion, gear, assembly, tca_opt, phi1)
+    return contact_zone(
+        positions,
+        tca.fm1.bounds,
+        tca.fm2.bounds,
+        assembly.side1,
+        assembly.side2,
+        options.g_max_mm,
+        n_teeth=options.n_teeth,
+    )
+
+
+def build_models(
+    pinion, gear, assembly, options: LTCAOptions, zone: ContactZone | None = None
+) -> MemberModels:
+    """Mesh both sectors, fine in the contact ``zone`` (default :func:`cycle_zone`), and
+    compute their compliance operators (cached)."""
     t0 = time.perf_counter()
-    sectors = [sector_mesh(m, options.n_teeth, options.level) for m in (pinion, gear)]
+    if zone is None:
+        zone = cycle_zone(pinion, gear, assembly, options)
+    sectors = [
+        sector_mesh(m, zone.n_teeth, options.level, zone=z or None)
+        for m, z in ((pinion, zone.pinion), (gear, zone.gear))
+    ]
     h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
     module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
     depth = layer = 0.0
@@ -168,11 +208,18 @@ def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
         layer = depth
     models = [
         build_member_model(
-            member.name, sm, side, options.E_MPa, options.nu, options.backend, layer_mm=layer
+            member.name,
+            sm,
+            side,
+            options.E_MPa,
+            options.nu,
+            options.backend,
+            layer_mm=layer,
+            teeth=tuple(sorted({q.tooth for q in z})) or None,
         )
-        for member, side, sm in (
-            (pinion, assembly.side1, sectors[0]),
-            (gear, assembly.side2, sectors[1]),
+        for member, side, sm, z in (
+            (pinion, assembly.side1, sectors[0], zone.pinion),
+            (gear, assembly.side2, sectors[1], zone.gear),
         )
     ]
     cell = options.cell_mm if options.cell_mm is not None else h
@@ -187,6 +234,7 @@ def build_models(pinion, gear, assembly, options: LTCAOptions) -> MemberModels:
         nu=options.nu,
         n_across=options.n_across,
         max_cells=options.max_cells,
+        zone=zone,
     )
 
 
@@ -235,8 +283,13 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
+            if not np.any(g.valid & (g.separation <= g_max)):
+                continue
             n = models.pinion.sector.n_teeth
-            msg = f"pair ({g.k}, {g.j}) lies outside the {n}-tooth sectors"
+            msg = (
+                f"pair ({g.k}, {g.j}) could touch (separation <= {g_max:.3g} mm) but lies "
+                f"outside the contact zone of the {n}-tooth sectors: not modelled"
+            )
             if msg not in warnings:
                 warnings.append(msg)
                 log.warning(msg)

@@ -183,7 +183,7 @@ def run_ltca(
     asm = tca.asm
     seconds["tca"] = time.perf_counter() - t0
     if models is None:
-        models = build_models(pinion, gear, asm, opt)
+        models = build_models(pinion, gear, assembly, opt)
     seconds["models"] = models.seconds
     t0 = time.perf_counter()
     parts = chunks(len(tca_pos), opt.chunk_positions)

@@ -63,6 +63,8 @@ class MemberModel:
         fidelity reads the FE displacement at a matching depth); 0 for ``fe`` and ``hertz``.
     layer_tets
         ``(n_tets,)`` bool, the tetrahedra whose DOFs are all in ``op`` (the layer), or None.
+    teeth
+        Sector teeth whose working flank (and layer) DOFs are in ``op``; None: all.
     """
 
     name: str
@@ -72,6 +74,7 @@ class MemberModel:
     side: str
     layer_mm: float = 0.0
     layer_tets: np.ndarray | None = None
+    teeth: tuple[int, ...] | None = None
 
     def boundary_of(self, tooth: int) -> str:
         """Boundary name of member tooth ``tooth``'s working flank in the sector."""
@@ -81,7 +84,9 @@ class MemberModel:
         return f"flank_{self.side}_{t}"
 
     def has_tooth(self, tooth: int) -> bool:
-        return 0 <= tooth + self.sector.centre_tooth < self.sector.n_teeth
+        """Member tooth ``tooth`` is in the sector and its flank in the operator."""
+        t = tooth + self.sector.centre_tooth
+        return 0 <= t < self.sector.n_teeth and (self.teeth is None or t in self.teeth)
 
 
 def build_member_model(
@@ -92,14 +97,18 @@ def build_member_model(
     nu: float,
     backend: str = "auto",
     layer_mm: float = 0.0,
+    teeth: tuple[int, ...] | None = None,
 ) -> MemberModel:
-    """Assemble a sector and compute ``(K⁻¹)_cc`` on all its working-flank DOFs (and, with
-    ``layer_mm > 0``, on the DOFs of the tetrahedra down to that depth below them)."""
+    """Assemble a sector and compute ``(K⁻¹)_cc`` on the working-flank DOFs of the sector
+    teeth ``teeth`` (None: all; the teeth that can touch, :mod:`fegear.ltca.zone`: the dense
+    operator costs the cube of its size) and, with ``layer_mm > 0``, on the DOFs of the
+    tetrahedra down to that depth below them."""
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
     clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
     body = assemble_body(mesh, E, nu, clamped)
-    flanks = [f"flank_{side}_{t}" for t in range(sector.n_teeth)]
+    teeth = tuple(range(sector.n_teeth)) if teeth is None else tuple(sorted(teeth))
+    flanks = [f"flank_{side}_{t}" for t in teeth]
     dofs = np.unique(np.concatenate([boundary_dofs(body.basis, f) for f in flanks]))
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
@@ -128,6 +137,7 @@ def build_member_model(
         side=side,
         layer_mm=layer_mm,
         layer_tets=layer_tets,
+        teeth=teeth,
     )
 
 

@@ -1,0 +1,100 @@
+"""The contact zone of a cycle (DESIGN §6, :mod:`fegear.ltca.zone`): which teeth the sectors need
+and where their meshes must be fine, from the TCA alone (FZG type C spur pair, contact ratio
+1.46, and a face gear with localized contact)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fegear.assembly import involute_assembly
+from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.ltca.zone import contact_zone
+from fegear.tca import TCA, TCAOptions, reference_phase
+
+PINION = InvoluteMember(
+    InvoluteDesign(16, 4.5, 20, profile_shift=0.1817, face_width_mm=14), "pinion"
+)
+GEAR = InvoluteMember(InvoluteDesign(24, 4.5, 20, profile_shift=0.1715, face_width_mm=14), "gear")
+
+
+@pytest.fixture(scope="module")
+def cycle():
+    asm = involute_assembly(PINION, GEAR)
+    opt = TCAOptions(n_positions=13, separation_grid=(24, 12))
+    a = asm.with_phase2(reference_phase(PINION, GEAR, asm, opt))
+    tca = TCA(PINION, GEAR, a, opt)
+    phi1 = -np.pi / 16 + 2 * np.pi / 16 * np.arange(13) / 13
+    return tca, tca.positions(phi1)
+
+
+def _inside(zones, tooth, u, v) -> np.ndarray:
+    """Points ``(u, v)`` of sector tooth ``tooth`` covered by one of its boxes."""
+    hit = np.zeros(u.shape, dtype=bool)
+    for z in zones:
+        if z.tooth == tooth:
+            hit |= (
+                (u >= z.u[0] - 1e-12)
+                & (u <= z.u[1] + 1e-12)
+                & (v >= z.v[0] - 1e-12)
+                & (v <= z.v[1] + 1e-12)
+            )
+    return hit
+
+
+def test_teeth_cover_every_pair_that_can_touch_plus_a_neighbour(cycle):
+    tca, pos = cycle
+    z = contact_zone(pos, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.02)
+    # contact ratio 1.46: over one pitch the pairs -1, 0, +1 come within 20 µm of touching
+    assert sorted(z.pairs[:, 0].tolist()) == [-1, 0, 1]
+    # ... so 3 loaded teeth + one unloaded neighbour on each side, symmetric about tooth 0
+    assert z.n_teeth == 5
+    teeth1 = {q.tooth for q in z.pinion}
+    assert teeth1 == {1, 2, 3}  # the neighbours 0 and 4 carry nothing: no fine zone there
+    # an explicit count is kept (pairs outside it get no zone)
+    z3 = contact_zone(pos, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.02, n_teeth=3)
+    assert z3.n_teeth == 3 and {q.tooth for q in z3.pinion} <= {0, 1, 2}
+
+
+def test_zone_holds_every_cell_that_can_touch_on_both_flanks(cycle):
+    tca, pos = cycle
+    gap = 0.02
+    z = contact_zone(pos, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", gap)
+    c = z.n_teeth // 2
+    b1, b2 = tca.fm1.bounds, tca.fm2.bounds
+    for box, b in [(q, b1) for q in z.pinion] + [(q, b2) for q in z.gear]:
+        # boxes lie on the working flank (clipped to its limits)
+        assert b.u_fillet - 1e-12 <= box.u[0] < box.u[1] <= b.u_tip + 1e-12
+        assert b.v_start - 1e-12 <= box.v[0] < box.v[1] <= b.v_end + 1e-12
+    n_checked = 0
+    for p in pos:
+        for g in p.grids:
+            near = g.valid & (g.separation <= gap)
+            if not near.any():
+                continue
+            U, V = np.meshgrid(g.u, g.v, indexing="ij")
+            assert _inside(z.pinion, g.k + c, U[near], V[near]).all(), (g.k, g.j)
+            gu, gv = g.gear_uv[near].T
+            assert _inside(z.gear, g.j + c, gu, gv).all(), (g.k, g.j)
+            n_checked += int(near.sum())
+    assert n_checked > 100  # the check saw the contact zone
+
+
+def test_a_larger_gap_never_shrinks_the_zone(cycle):
+    tca, pos = cycle
+    small = contact_zone(pos, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.005)
+    large = contact_zone(pos, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.05)
+    rng = np.random.default_rng(0)
+    c = small.n_teeth // 2
+    for q in small.pinion:
+        u = rng.uniform(*q.u, 200)
+        v = rng.uniform(*q.v, 200)
+        t = q.tooth - c + large.n_teeth // 2
+        assert _inside(large.pinion, t, u, v).all()
+
+
+def test_positions_without_grids_are_refused(cycle):
+    tca, _ = cycle
+    bare = tca.positions(np.array([0.0]), with_grids=False)
+    with pytest.raises(ValueError, match="separation grids"):
+        contact_zone(bare, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.02)
