@@ -102,7 +102,8 @@ def _hertz_patch(a: float, b: float, angle: float, size: tuple[float, float], tu
     u = X * np.cos(t) + Y * np.sin(t)
     v = -X * np.sin(t) + Y * np.cos(t)
     p = np.sqrt(np.clip(1 - (u / a) ** 2 - (v / b) ** 2, 0, None))
-    cells = SimpleNamespace(k=0, j=0, n=X.size, local=np.stack([X, Y], -1))
+    # unit moment arms: the torque shares are the force shares
+    cells = SimpleNamespace(k=0, j=0, n=X.size, local=np.stack([X, Y], -1), h=np.ones(X.size))
     return cells, SimpleNamespace(force=p * size[0] * size[1])
 
 
@@ -148,7 +149,7 @@ def test_an_idle_pair_on_coarse_cells_gets_the_loaded_pairs_grid():
     ideal = (2 * b / 10, 2 * a / 10)
     loaded, sol = _hertz_patch(a, b, np.pi / 2, ideal, 0.0)  # accepted as it is
     for idle_size, remade in (((2.5, 2.5), True), ((0.08, 1.0), False)):
-        idle = SimpleNamespace(k=1, j=1, n=3, local=np.zeros((3, 2)))
+        idle = SimpleNamespace(k=1, j=1, n=3, local=np.zeros((3, 2)), h=np.ones(3))
         both = SimpleNamespace(force=np.concatenate([sol.force, np.zeros(3)]))
         cell = {None: (2.5, 2.5, 0.0), (0, 0): (*ideal, 0.0), (1, 1): (*idle_size, 0.0)}
         new = refined_sizes([loaded, idle], both, cell, 8)
@@ -156,6 +157,31 @@ def test_an_idle_pair_on_coarse_cells_gets_the_loaded_pairs_grid():
             assert new is not None and new[(1, 1)] == new[(0, 0)] == cell[(0, 0)]
         else:
             assert new is None
+
+
+def test_a_pair_with_a_negligible_share_does_not_drive_the_refinement():
+    """A pair with less than 1 % of the torque (an edge contact starting or ending) keeps its
+    grid; the same patch with more load is refined."""
+    from types import SimpleNamespace
+
+    from fegear.ltca.hybrid import MIN_REFINE_SHARE, refined_sizes
+
+    a, b = 4.0, 0.3
+    ideal = (2 * b / 10, 2 * a / 10)
+    big, sol_big = _hertz_patch(a, b, np.pi / 2, ideal, 0.0)  # accepted as it is
+    coarse = (0.25, 0.25)  # 2.4 cells across a second, small patch: too coarse for n_across 8
+    small, sol_small = _hertz_patch(1.0, 0.3, np.pi / 2, coarse, 0.0)
+    small = SimpleNamespace(**{**vars(small), "k": 1, "j": 1})
+    for share, refined in ((0.5 * MIN_REFINE_SHARE, False), (2.0 * MIN_REFINE_SHARE, True)):
+        f_small = sol_small.force / sol_small.force.sum() * share
+        f_big = sol_big.force / sol_big.force.sum() * (1.0 - share)
+        sol = SimpleNamespace(force=np.concatenate([f_big, f_small]))
+        cell = {None: (2.5, 2.5, 0.0), (0, 0): (*ideal, 0.0), (1, 1): (*coarse, 0.0)}
+        new = refined_sizes([big, small], sol, cell, 8)
+        if refined:
+            assert new is not None and new[(1, 1)] != cell[(1, 1)]
+        else:
+            assert new is None  # nothing to refine: the big patch is resolved
 
 
 def _face_gear_cycle(options, phi1=None):

@@ -121,6 +121,16 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
     return C
 
 
+#: A pair carrying less than this share of the torque does not drive the refinement.
+MIN_REFINE_SHARE = 0.01
+
+
+def _starts(cells):
+    """``(cells, offset)`` pairs: where each pair's cells start in the stacked unknowns."""
+    offsets = np.cumsum([0] + [c.n for c in cells])[:-1]
+    return zip(cells, offsets.tolist(), strict=True)
+
+
 def refined_sizes(cells, sol, cell, n_across, remake=False):
     """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
     grids are fine enough.
@@ -141,11 +151,15 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     pass, as a coarse grid over-estimates the patch. Each pair gets its own grid: a small patch
     (an edge contact carrying little load) does not refine its neighbour. ``remake``: every
     loaded pair gets the grid made for its patch, accepted or not (the start of the next
-    position); pairs without load are left out (they start from the default cells).
+    position); pairs without load are left out (they start from the default cells). A pair
+    carrying less than ``MIN_REFINE_SHARE`` of the torque keeps its grid: it is an edge contact
+    starting or ending, whose patch shrinks with every refinement (measured on the seed face
+    gear: a pair with 0.3 % of the torque cost two extra solves of ~1050 cells at one position).
     """
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
     idle, heaviest = [], None
+    torque = sum(float(c.h @ sol.force[a : a + c.n]) for c, a in _starts(cells))
     for c in cells:
         F = sol.force[start : start + c.n]
         start += c.n
@@ -153,6 +167,9 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
         now = cell.get(key, cell[None])
         if not np.any(F > 0):
             idle.append((key, now))
+            continue
+        if float(c.h @ F) < MIN_REFINE_SHARE * torque:
+            new[key] = now
             continue
         if heaviest is None or F.sum() > heaviest[0]:
             heaviest = (float(F.sum()), key)
