@@ -52,8 +52,8 @@ for key, cyc in (("3e6", c), ("6e6", c2)):
         "te_loaded": cyc.te_loaded_arcsec.tolist(), "phi1_deg": np.degrees(cyc.phi1).tolist(),
         "n_in_contact": cyc.n_in_contact.tolist(),
     }
-from fegear.mesh.sector import sector_mesh
-out["dofs"] = [3 * sector_mesh(m, 3, lv).points.shape[0] for m in (pin, fg)]
+models = build_models(pin, fg, asm, opt)  # the sectors the cycle used (cached)
+out["dofs"] = [3 * m.sector.points.shape[0] for m in (models.pinion, models.gear)]
 print(json.dumps(out))
 """
 
