@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from fegear.assembly import involute_assembly
+from fegear.errors import InputError
 from fegear.geometry import InvoluteDesign, InvoluteMember
 from fegear.ltca.zone import contact_zone
 from fegear.tca import TCA, TCAOptions, reference_phase
@@ -96,5 +97,5 @@ def test_a_larger_gap_never_shrinks_the_zone(cycle):
 def test_positions_without_grids_are_refused(cycle):
     tca, _ = cycle
     bare = tca.positions(np.array([0.0]), with_grids=False)
-    with pytest.raises(ValueError, match="separation grids"):
+    with pytest.raises(InputError, match="separation grids"):
         contact_zone(bare, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.02)

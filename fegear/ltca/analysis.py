@@ -27,11 +27,7 @@ The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair: see
 from __future__ import annotations
 
 import logging
-import multiprocessing
-import os
 import time
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,7 +45,7 @@ from fegear.ltca.model import (
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.warm import active_guess, footprint
 from fegear.ltca.zone import ContactZone, contact_zone
-from fegear.mesh.sector import FINE, sector_mesh, sector_mesh_cached
+from fegear.mesh.sector import FINE, sector_mesh
 from fegear.patch import measure_patch
 from fegear.tca import TCA, TCAOptions
 from fegear.tca.cached import cached_tca
@@ -192,36 +188,6 @@ def cycle_zone(pinion, gear, assembly, options: LTCAOptions) -> ContactZone:
     )
 
 
-def _mesh_job(member, n_teeth: int, level: int, zone) -> None:
-    sector_mesh(member, n_teeth, level, zone=zone)
-
-
-def _sector_meshes(jobs, n_teeth: int, level: int) -> list:
-    """The sector meshes of ``jobs`` (``[(member, zone)]``). When more than one is to be made and
-    the process can fork, they are made in parallel processes (gmsh runs on one thread here, for
-    deterministic meshes): the seed face gear's two sectors take 9.4 s instead of 3.1 + 9.1 s
-    (measured). ``$FEGEAR_WORKERS=1`` keeps them in this process. The children only fill the
-    cache; the meshes are read from it here."""
-    missing = [(m, z) for m, z in jobs if not sector_mesh_cached(m, n_teeth, level, zone=z)]
-    env = os.environ.get("FEGEAR_WORKERS", "").strip()  # as for the positions
-    cores = int(env) if env.isdigit() and int(env) >= 1 else (os.cpu_count() or 1)
-    if (
-        len(missing) > 1
-        and cores > 1
-        and "fork" in multiprocessing.get_all_start_methods()
-        and not multiprocessing.current_process().daemon
-    ):
-        ctx = multiprocessing.get_context("fork")
-        try:
-            with ProcessPoolExecutor(max_workers=min(cores, len(missing)), mp_context=ctx) as pool:
-                futures = [pool.submit(_mesh_job, m, n_teeth, level, z) for m, z in missing]
-                for f in futures:
-                    f.result()
-        except BrokenProcessPool:
-            log.warning("a meshing process died; meshing in this process")
-    return [sector_mesh(m, n_teeth, level, zone=z) for m, z in jobs]
-
-
 def build_models(
     pinion, gear, assembly, options: LTCAOptions, zone: ContactZone | None = None
 ) -> MemberModels:
@@ -230,9 +196,8 @@ def build_models(
     t0 = time.perf_counter()
     if zone is None:
         zone = cycle_zone(pinion, gear, assembly, options)
-    sectors = _sector_meshes(
-        [(pinion, zone.pinion or None), (gear, zone.gear or None)], zone.n_teeth, options.level
-    )
+    jobs = [(pinion, zone.pinion or None), (gear, zone.gear or None)]
+    sectors = [sector_mesh(m, zone.n_teeth, options.level, zone=z) for m, z in jobs]
     h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
     module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
     depth = layer = 0.0

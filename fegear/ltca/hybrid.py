@@ -125,12 +125,6 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
 MIN_REFINE_SHARE = 0.01
 
 
-def _starts(cells):
-    """``(cells, offset)`` pairs: where each pair's cells start in the stacked unknowns."""
-    offsets = np.cumsum([0] + [c.n for c in cells])[:-1]
-    return zip(cells, offsets.tolist(), strict=True)
-
-
 def refined_sizes(cells, sol, cell, n_across, remake=False):
     """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
     grids are fine enough.
@@ -159,7 +153,7 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
     idle, heaviest = [], None
-    torque = sum(float(c.h @ sol.force[a : a + c.n]) for c, a in _starts(cells))
+    torque = float(np.concatenate([c.h for c in cells]) @ sol.force)
     for c in cells:
         F = sol.force[start : start + c.n]
         start += c.n

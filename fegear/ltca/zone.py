@@ -38,7 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.ndimage import binary_dilation
 
+from fegear.errors import InputError
 from fegear.mesh.sector import FlankZone
 from fegear.tca.results import PositionResult
 
@@ -73,12 +75,7 @@ class ContactZone:
 
 def _dilate(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """Binary dilation by one cell (3 × 3 neighbourhood)."""
-    p = np.pad(mask, 1)
-    out = np.zeros_like(mask)
-    for a in range(3):
-        for b in range(3):
-            out |= p[a : a + mask.shape[0], b : b + mask.shape[1]]
-    return out
+    return binary_dilation(mask, structure=np.ones((3, 3), dtype=bool))
 
 
 def _boxes(mask: NDArray[np.bool_], u: Array, v: Array, tooth: int, side: str) -> list[FlankZone]:
@@ -139,7 +136,7 @@ def contact_zone(
     """
     grids = [g for p in positions for g in p.grids]
     if not grids:
-        raise ValueError("contact_zone: the positions carry no separation grids")
+        raise InputError("positions", "without separation grids", "TCA positions with grids")
     near_pairs = sorted(
         {(int(g.k), int(g.j)) for g in grids if np.any(g.valid & (g.separation <= gap_mm))}
     )

@@ -81,7 +81,6 @@ __all__ = [
     "mesh_sizes",
     "default_zone",
     "sector_mesh",
-    "sector_mesh_cached",
     "load_sector_mesh",
 ]
 
@@ -507,30 +506,6 @@ def _cad_deviation(gmsh, fr: SectorFrame, groups: dict[str, list[int]], n_teeth:
 
 
 # ------------------------------------------------------------------------------ public API
-def _params(member, n_teeth, level, zone, rim_modules, algorithm, min_sicn):
-    """Validated inputs of :func:`sector_mesh`: its frame, zone and cache key parameters."""
-    if not isinstance(n_teeth, int) or not 1 <= n_teeth <= member.n_teeth // 2:
-        raise InputError("mesh.n_teeth", n_teeth, f"an integer in 1..{member.n_teeth // 2}")
-    mesh_sizes(1.0, level)
-    fr = sector_frame(member, rim_modules)
-    zone = tuple(default_zone(fr, n_teeth) if zone is None else zone)
-    for z in zone:
-        if not 0 <= z.tooth < n_teeth:
-            raise InputError("mesh.zone.tooth", z.tooth, f"in 0..{n_teeth - 1}")
-    params = {
-        "version": _VERSION,
-        "member": repr(member),
-        "family": fr.family,
-        "n_teeth": n_teeth,
-        "level": level,
-        "zone": [[z.tooth, z.side, list(z.u), list(z.v)] for z in zone],
-        "rim_modules": rim_modules,
-        "algorithm": algorithm,
-        "min_sicn": min_sicn,
-    }
-    return fr, zone, params
-
-
 def sector_mesh(
     member: GeneratedMember,
     n_teeth: int = 3,
@@ -565,7 +540,25 @@ def sector_mesh(
     MeshError
         If the solid cannot be built, named, or meshed with acceptable quality.
     """
-    fr, zone, params = _params(member, n_teeth, level, zone, rim_modules, algorithm, min_sicn)
+    if not isinstance(n_teeth, int) or not 1 <= n_teeth <= member.n_teeth // 2:
+        raise InputError("mesh.n_teeth", n_teeth, f"an integer in 1..{member.n_teeth // 2}")
+    mesh_sizes(1.0, level)
+    fr = sector_frame(member, rim_modules)
+    zone = tuple(default_zone(fr, n_teeth) if zone is None else zone)
+    for z in zone:
+        if not 0 <= z.tooth < n_teeth:
+            raise InputError("mesh.zone.tooth", z.tooth, f"in 0..{n_teeth - 1}")
+    params = {
+        "version": _VERSION,
+        "member": repr(member),
+        "family": fr.family,
+        "n_teeth": n_teeth,
+        "level": level,
+        "zone": [[z.tooth, z.side, list(z.u), list(z.v)] for z in zone],
+        "rim_modules": rim_modules,
+        "algorithm": algorithm,
+        "min_sicn": min_sicn,
+    }
     side_path = cache_dir("mesh") / f"{content_hash(params)}.json"
     diag_box: dict[str, object] = {}
 
@@ -625,20 +618,6 @@ def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray
     except OSError as exc:  # a read-only cache still works, only slower
         log.debug("mesh arrays not cached (%s)", exc)
     return points, tets, bnd
-
-
-def sector_mesh_cached(
-    member: GeneratedMember,
-    n_teeth: int = 3,
-    level: int = 0,
-    zone: Sequence[FlankZone] | None = None,
-    rim_modules: float = 3.0,
-    algorithm: int = 10,
-    min_sicn: float = 0.03,
-) -> bool:
-    """Whether :func:`sector_mesh` with these arguments would read its mesh from the cache."""
-    _, _, params = _params(member, n_teeth, level, zone, rim_modules, algorithm, min_sicn)
-    return (cache_dir("mesh") / f"{content_hash(params)}.msh").exists()
 
 
 def load_sector_mesh(
