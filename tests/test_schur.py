@@ -22,6 +22,7 @@ from fegear.linalg import (
     _mkl_pardiso,
     available_backends,
     inverse_block,
+    inverse_columns,
     resolve_backend,
     schur,
     schur_complement,
@@ -293,3 +294,70 @@ def test_a_bad_backend_name_is_refused_on_an_operator_cache_hit(tmp_path, monkey
     np.testing.assert_array_equal(np.asarray(again.G), first.G)  # read back bit for bit
     with pytest.raises(InputError, match="backend"):
         candidate_operator(body, dofs, "mumps", cache_key=key)
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_inverse_columns_are_the_columns_of_the_inverse_block(box, reference, backend) -> None:
+    """Block elimination onto the load DOFs gives the same columns as the whole inverse."""
+    if backend == "pardiso":
+        _needs_pardiso()
+    K, idx = box
+    cols = np.zeros(idx.size, dtype=bool)
+    cols[np.random.default_rng(3).choice(idx.size, idx.size // 3, replace=False)] = True
+    G = inverse_columns(K, idx, cols, backend)
+    assert G.shape == (idx.size, cols.sum())
+    assert _rel(G, reference[:, cols]) < TOL_SOLVERS
+    # every column mask, all-True included, gives the square symmetric block
+    np.testing.assert_array_equal(
+        inverse_columns(K, idx, np.ones(idx.size, bool), backend), inverse_block(K, idx, backend)
+    )
+
+
+def test_inverse_columns_through_the_mkl_cholesky(box, reference, monkeypatch) -> None:
+    """The MKL dense Cholesky (used above the OpenBLAS size limit) gives the same columns."""
+    _needs_pardiso()
+    monkeypatch.setattr(schur, "_OPENBLAS_POTRF_MAX", 10)
+    K, idx = box
+    cols = np.arange(idx.size) % 4 == 0
+    assert _rel(inverse_columns(K, idx, cols, "pardiso"), reference[:, cols]) < TOL_SOLVERS
+
+
+def test_inverse_columns_refuses_a_bad_mask(box) -> None:
+    K, idx = box
+    with pytest.raises(InputError, match="columns"):
+        inverse_columns(K, idx, np.arange(idx.size) % 2, "superlu")
+
+
+def test_operator_on_load_columns_and_its_guard() -> None:
+    """An operator kept only on its load columns gives the same loads-to-readings compliance as
+    the square one; a load on a free DOF outside its columns is an error, never a silent clamp;
+    a load on a clamped DOF does no work and is ignored."""
+    from fegear.compliance import body_compliance, candidate_operator, cross_compliance
+    from fegear.fem.elasticity import assemble_body
+
+    mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 3)] * 3).with_boundaries(
+        {"bottom": lambda x: x[2] < 1e-9}
+    )
+    body = assemble_body(mesh, 206000.0, 0.3, [("bottom", "xyz")])
+    cand = body.free[-30:]
+    loads, reads = cand[-10:], cand[:20]
+    square = candidate_operator(body, cand, "superlu")
+    narrow = candidate_operator(body, cand, "superlu", load_dofs=loads)
+    assert narrow.G.shape == (30, 10) and square.G.shape == (30, 30)
+    rng = np.random.default_rng(5)
+
+    def spread(dofs, n):  # (n_dofs, n) with random entries on ``dofs``
+        M = np.zeros((body.n_dofs, n))
+        M[dofs] = rng.standard_normal((dofs.size, n))
+        return sp.csr_matrix(M)
+
+    P, Q = spread(loads, 4), spread(reads, 3)
+    # two eliminations of the same matrix: round-off apart
+    assert _rel(body_compliance(narrow, P), body_compliance(square, P)) < TOL_SOLVERS
+    assert _rel(cross_compliance(narrow, Q, P), cross_compliance(square, Q, P)) < TOL_SOLVERS
+    with pytest.raises(SolverError, match="outside the compliance operator"):
+        body_compliance(narrow, spread(reads[:1], 1))
+    clamped = np.setdiff1d(np.arange(body.n_dofs), body.free)[:3]
+    P_c = spread(np.concatenate([clamped, loads]), 2)
+    P_only = sp.csr_matrix(P_c.toarray() * np.isin(np.arange(body.n_dofs), loads)[:, None])
+    np.testing.assert_array_equal(body_compliance(narrow, P_c), body_compliance(narrow, P_only))

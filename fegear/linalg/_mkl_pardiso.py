@@ -224,6 +224,33 @@ class MklPardiso:
             a[i1:, i0:i1] = a[i0:i1, i1:].T
         return a
 
+    def spd_cholesky(self, S: np.ndarray) -> np.ndarray:
+        """Lower Cholesky factor ``L`` (``S = L Lᵀ``) of a dense SPD matrix by MKL ``dpotrf``, on
+        a row-major copy (for the same reason as :meth:`spd_inverse`); the strict upper triangle
+        is zeroed.
+
+        Raises
+        ------
+        SolverError
+            ``S`` is not numerically positive definite, or LAPACK reports an error.
+        """
+        n = S.shape[0]
+        a = np.array(S, dtype=np.float64, order="C", copy=True)
+        # Column-major upper factor (S = Uᵀ U) of the C array = row-major lower L = Uᵀ.
+        fn = self.lib.LAPACKE_dpotrf
+        fn.restype = ctypes.c_int
+        fn.argtypes = [ctypes.c_int, ctypes.c_char, ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
+        info = fn(102, ctypes.c_char(b"U"), n, a.ctypes.data, n)
+        if info > 0:
+            raise SolverError(f"matrix is not positive definite (leading minor {info})")
+        if info != 0:
+            raise SolverError(f"MKL LAPACKE_dpotrf failed: info = {info}")
+        for i0 in range(0, n, 2048):  # zero the strict upper triangle, a block of rows at a time
+            i1 = min(i0 + 2048, n)
+            a[i0:i1, i0:i1] = np.tril(a[i0:i1, i0:i1])
+            a[i0:i1, i1:] = 0.0
+        return a
+
     def schur_spd(
         self, upper: sp.csr_matrix, schur_rows: np.ndarray, n_threads: int | None
     ) -> np.ndarray:

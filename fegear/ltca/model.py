@@ -2,8 +2,9 @@
 
 Each member is a sector of ``n`` teeth (:mod:`fegear.mesh.sector`) in its own frame, clamped at the
 bore (or the face-gear base) and at both sector cuts. The candidate DOFs are all DOFs of the
-nodes on the working flanks of the teeth that can engage: the flank points move with the teeth,
-so one Schur complement (``(K⁻¹)_cc``) serves every mesh position and every torque
+nodes on the working flanks of the teeth that can engage (and, for ``hybrid``, of a layer below
+them, read but never loaded: the operator keeps only the flank columns): the flank points move
+with the teeth, so one Schur complement (``(K⁻¹)_cc``) serves every mesh position and every torque
 (:func:`fegear.compliance.candidate_operator`, cached on disk by content hash). A mesh position
 then costs only locating its cells on the flank facets (sparse ``P``) and ``C = Pᵀ G P``.
 
@@ -55,7 +56,8 @@ class MemberModel:
     body
         The elastic body (bases, free DOFs; stiffness assembled only when the operator is built).
     op
-        ``(K⁻¹)_cc`` on the DOFs of the working flanks of the sector teeth.
+        ``(K⁻¹)_cf``: rows on the DOFs of the working flanks of the sector teeth (and the layer),
+        columns on the flank DOFs.
     side
         Working flank side ("drive" or "coast").
     layer_mm
@@ -116,11 +118,12 @@ def build_member_model(
         "flanks": flanks,
         "layer_mm": layer_mm,
     }
+    flank_dofs = dofs  # the cells load only these; the layer is only read
     layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
     if layer_mm > 0.0:
         layer_tets[_cached_layer_tets(mesh, flanks, layer_mm, key)] = True
         dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
-    op = candidate_operator(body, dofs, backend=backend, cache_key=key)
+    op = candidate_operator(body, dofs, backend=backend, cache_key=key, load_dofs=flank_dofs)
     log.info(
         "%s: %d DOFs, %d candidate DOFs, operator in %.1f s (%s)",
         name,

@@ -91,7 +91,7 @@ Array = NDArray[np.float64]
 FINE = (0.45, 0.32, 0.22, 0.16, 0.11)
 #: coarse (far-field) element size per level, in modules
 COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
-_VERSION = "sector-2"
+_VERSION = "sector-3"  # 3: zone seeds interpolated (_zone_points)
 
 
 class FlankZone(NamedTuple):
@@ -275,19 +275,41 @@ def _classify(gmsh, fr: SectorFrame, faces: list[int], n_teeth: int) -> dict[str
 
 
 def _zone_points(fr: SectorFrame, zone: Sequence[FlankZone], spacing: float, n_teeth: int) -> Array:
-    """Points on the analytic flanks covering the zone boxes at about ``spacing``."""
-    out = []
-    for z in zone:
-        k = z.tooth - n_teeth // 2
-        u = np.linspace(*z.u, 9)
-        v = np.linspace(*z.v, 9)
-        P = fr.tooth_points(z.side, k, u[:, None], v[None, :])
-        lu = np.max(np.sum(np.linalg.norm(np.diff(P, axis=0), axis=-1), axis=0))
-        lv = np.max(np.sum(np.linalg.norm(np.diff(P, axis=1), axis=-1), axis=1))
-        nu, nv = max(2, math.ceil(lu / spacing) + 1), max(2, math.ceil(lv / spacing) + 1)
-        u, v = np.linspace(*z.u, nu), np.linspace(*z.v, nv)
-        out.append(fr.tooth_points(z.side, k, u[:, None], v[None, :]).reshape(-1, 3))
-    return np.vstack(out)
+    """Points on the flanks covering the zone boxes at about ``spacing`` (the seeds of the fine
+    mesh-size field).
+
+    The flank of tooth 0 is evaluated exactly on a 25 × 25 grid over the ``(u, v)`` bounding box
+    of all boxes of a side, and the box grids are interpolated from it (bicubic splines per
+    coordinate) and rotated to their teeth. A face-gear flank point is an iterative envelope
+    solve of ~1 ms: evaluating every box exactly took 3.3-6.2 s of the seed face gear's 8 s
+    sector mesh (44 boxes, 3096 points); the splines take 0.2 s, are within 0.0005 mm of the
+    exact points there, far below any element size, and only place the size field.
+    """
+    from scipy.interpolate import RectBivariateSpline
+
+    zone = list(zone)
+    out: list[Array] = [np.zeros((0, 3))] * len(zone)
+    for side in sorted({z.side for z in zone}):
+        idx = [i for i, z in enumerate(zone) if z.side == side]
+        ug = np.linspace(min(zone[i].u[0] for i in idx), max(zone[i].u[1] for i in idx), 25)
+        vg = np.linspace(min(zone[i].v[0] for i in idx), max(zone[i].v[1] for i in idx), 25)
+        if np.ptp(ug) <= 0.0 or np.ptp(vg) <= 0.0:
+            raise InputError("mesh.zone", "a box of zero extent", "boxes with u0 < u1, v0 < v1")
+        G = fr.flank_points(side, ug[:, None], vg[None, :])  # (25, 25, 3)
+        splines = [RectBivariateSpline(ug, vg, G[..., c]) for c in range(3)]
+
+        def at(u: Array, v: Array) -> Array:
+            return np.stack([s(u, v) for s in splines], axis=-1)  # noqa: B023 (used at once)
+
+        for i in idx:
+            z = zone[i]
+            P = at(np.linspace(*z.u, 9), np.linspace(*z.v, 9))
+            lu = np.max(np.sum(np.linalg.norm(np.diff(P, axis=0), axis=-1), axis=0))
+            lv = np.max(np.sum(np.linalg.norm(np.diff(P, axis=1), axis=-1), axis=1))
+            nu, nv = max(2, math.ceil(lu / spacing) + 1), max(2, math.ceil(lv / spacing) + 1)
+            pts = at(np.linspace(*z.u, nu), np.linspace(*z.v, nv)).reshape(-1, 3)
+            out[i] = fr.on_tooth(pts, z.tooth - n_teeth // 2)
+    return np.vstack(out) if out else np.zeros((0, 3))
 
 
 def _build(

@@ -173,7 +173,11 @@ class SectorFrame:
     def tooth_points(self, side: Side, k: Array | int, u: Array, v: Array) -> Array:
         """Exact flank points of member teeth ``k`` (broadcast ``k``, ``u``, ``v``)."""
         k, u, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (k, u, v)))
-        return _rotate(self.flank_points(side, u, v), k * self.tau)
+        return self.on_tooth(self.flank_points(side, u, v), k)
+
+    def on_tooth(self, points: Array, k: Array | int) -> Array:
+        """Points ``(..., 3)`` of tooth 0 carried to member teeth ``k`` (a turn by ``k τ``)."""
+        return _rotate(np.asarray(points, dtype=float), np.asarray(k, dtype=float) * self.tau)
 
 
 def _unit(v: Array) -> Array:

@@ -394,8 +394,9 @@ def run_level(
                 ]
             )
             Q = probe_operator(body, surf + depth * direction, direction)
-            cand = np.union1d(np.unique(P.nonzero()[0]), np.unique(Q.nonzero()[0]))
-            op = candidate_operator(body, cand, backend=backend, cache_key=key)
+            loaded = np.unique(P.nonzero()[0])
+            cand = np.union1d(loaded, np.unique(Q.nonzero()[0]))
+            op = candidate_operator(body, cand, backend=backend, cache_key=key, load_dofs=loaded)
             Cb, near = hybrid_compliance(
                 op, P, Q, centers, 0.5 * s, depth, E, nu, quarter=scene.symmetry == "quarter"
             )
