@@ -109,13 +109,9 @@ def _f_depth(X: np.ndarray, Y: np.ndarray, z: float) -> tuple[np.ndarray, np.nda
     ``z``; Gradshteyn & Ryzhik 2.271, 2.284).
     """
     rho = np.sqrt(X * X + Y * Y + z * z)
-    i1 = (
-        X * np.arcsinh(Y / np.sqrt(X * X + z * z))
-        + Y * np.arcsinh(X / np.sqrt(Y * Y + z * z))
-        - z * np.arctan(X * Y / (z * rho))
-    )
     i2 = np.arctan(X * Y / (z * rho))
-    return i1, i2
+    i1 = X * np.arcsinh(Y / np.sqrt(X * X + z * z)) + Y * np.arcsinh(X / np.sqrt(Y * Y + z * z))
+    return i1 - z * i2, i2
 
 
 def subsurface_influence(
