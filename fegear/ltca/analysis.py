@@ -165,12 +165,15 @@ class MemberModels:
     zone: ContactZone | None = None
 
 
-def cycle_zone(pinion, gear, assembly, options: LTCAOptions) -> ContactZone:
+def cycle_zone(
+    pinion, gear, assembly, options: LTCAOptions, gap_mm: float | None = None
+) -> ContactZone:
     """The contact zone (:func:`fegear.ltca.zone.contact_zone`) of the default cycle of
     ``_ZONE_POSITIONS`` positions (the TCA comes from its cache), with the separation bound
-    ``g_max`` (where the contact grids start; a position whose ``g_max`` had to grow past it warns
-    if a pair outside the zone could then touch). The zone does not depend on the positions asked
-    for, so every run on the pair shares the meshes."""
+    ``gap_mm`` (default ``g_max``, where the contact grids start; when a load makes ``g_max``
+    grow past it so that a pair outside the zone could touch, :func:`fegear.ltca.run_ltca`
+    rebuilds the sectors on the zone of the grown bound). The zone does not depend on the
+    positions asked for, so every run on the pair shares the meshes."""
     n = _ZONE_POSITIONS
     tca_opt = TCAOptions(
         n_positions=n, separation_grid=options.tca_grid, E_MPa=options.E_MPa, nu=options.nu
@@ -183,7 +186,7 @@ def cycle_zone(pinion, gear, assembly, options: LTCAOptions) -> ContactZone:
         tca.fm2.bounds,
         assembly.side1,
         assembly.side2,
-        options.g_max_mm,
+        options.g_max_mm if gap_mm is None else gap_mm,
         n_teeth=options.n_teeth,
     )
 

@@ -30,12 +30,19 @@ from types import SimpleNamespace
 import numpy as np
 
 from fegear.errors import InputError, SolverError
-from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, solve_position
+from fegear.ltca.analysis import (
+    LTCAOptions,
+    MemberModels,
+    build_models,
+    cycle_zone,
+    solve_position,
+)
 from fegear.ltca.results import LoadedCycle, LoadedPosition
+from fegear.ltca.zone import ContactZone
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 
-__all__ = ["run_ltca", "chunks"]
+__all__ = ["run_ltca", "chunks", "grown_zone"]
 
 log = logging.getLogger(__name__)
 
@@ -196,6 +203,19 @@ def run_ltca(
         "torque": float(torque2_Nmm),
     }
     out = _solve_all(job, parts, workers, progress)
+    for _ in range(3):
+        grown = grown_zone(pinion, gear, assembly, opt, models, out)
+        if grown is None:
+            break
+        log.warning(
+            "g_max grew to %.3g mm: a pair outside the contact zone of the sectors can touch; "
+            "rebuilding them on the zone of that bound (pairs %s) and solving again",
+            grown.gap_mm,
+            [tuple(int(x) for x in p) for p in grown.pairs],
+        )
+        models = build_models(pinion, gear, assembly, opt, zone=grown)
+        seconds["models"] += models.seconds
+        out = _solve_all({**job, "models": models}, parts, workers, progress)
     seconds["positions"] = time.perf_counter() - t0
     log.info("%d positions in %.2f s (%d workers)", len(out), seconds["positions"], workers)
     return LoadedCycle(
@@ -209,4 +229,35 @@ def run_ltca(
         level=opt.level,
         seconds=seconds,
         phase2=float(asm.phase2),
+        zone_gap_mm=float(models.zone.gap_mm) if models.zone is not None else 0.0,
     )
+
+
+def grown_zone(
+    pinion, gear, assembly, opt: LTCAOptions, models: MemberModels, solved: list[LoadedPosition]
+) -> ContactZone | None:
+    """The contact zone the solved positions need, if the models' zone is too small for them.
+
+    A load whose elastic approach exceeds the zone's separation bound makes ``g_max`` grow past
+    it (:func:`fegear.ltca.analysis.solve_position`); pairs that could then touch but lie outside
+    the zone teeth were left out (and reported). Returns the cycle zone at the largest ``g_max``
+    used when it brings such a pair into the model, else None (also when the zone could not grow:
+    a fixed ``n_teeth`` too small for the pair).
+    """
+    if models.zone is None:
+        return None
+    g_used = max((p.g_max_mm for p in solved), default=0.0)
+    if g_used <= models.zone.gap_mm:
+        return None
+    zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=g_used)
+    c = zone.n_teeth // 2
+    teeth1 = {z.tooth - c for z in zone.pinion}
+    teeth2 = {z.tooth - c for z in zone.gear}
+    missing = [
+        (int(k), int(j))
+        for k, j in zone.pairs
+        if not (models.pinion.has_tooth(int(k)) and models.gear.has_tooth(int(j)))
+    ]
+    if not missing or not all(k in teeth1 and j in teeth2 for k, j in missing):
+        return None
+    return zone

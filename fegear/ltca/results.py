@@ -135,6 +135,10 @@ class LoadedCycle:
     phase2
         rad, the member-2 phase the TCA closed the pair with (``assembly.with_phase2(phase2)`` is
         the assembly every position was solved in).
+    zone_gap_mm
+        mm, the separation bound of the contact zone the sectors were built on (larger than
+        ``g_max`` when the load made the zone grow, :func:`fegear.ltca.cycle.grown_zone`); 0 for
+        models without a zone.
     """
 
     positions: tuple[LoadedPosition, ...]
@@ -147,6 +151,7 @@ class LoadedCycle:
     level: int
     seconds: dict[str, float]
     phase2: float = 0.0
+    zone_gap_mm: float = 0.0
 
     @property
     def te_pp_unloaded_arcsec(self) -> float:
