@@ -204,18 +204,8 @@ class MklPardiso:
         a = np.array(S, dtype=np.float64, order="C", copy=True)
         # The C array read column-major is Sᵀ = S: factor its lower triangle in LAPACK's own
         # layout (LAPACKE's row-major path would transpose the whole matrix twice).
-        col_major, uplo = 102, ctypes.c_char(b"L")
-        for name in ("LAPACKE_dpotrf", "LAPACKE_dpotri"):
-            fn = getattr(self.lib, name)
-            fn.restype = ctypes.c_int
-            fn.argtypes = [ctypes.c_int, ctypes.c_char, ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
-            info = fn(col_major, uplo, n, a.ctypes.data, n)
-            if info > 0 and name == "LAPACKE_dpotrf":
-                raise SolverError(
-                    f"Schur complement is not positive definite (leading minor {info})"
-                )
-            if info != 0:
-                raise SolverError(f"MKL {name} failed: info = {info}")
+        self._lapacke_spd("LAPACKE_dpotrf", b"L", a)
+        self._lapacke_spd("LAPACKE_dpotri", b"L", a)
         # Column-major lower = row-major upper triangle: mirror it, a block of rows at a time.
         for i0 in range(0, n, 2048):
             i1 = min(i0 + 2048, n)
@@ -223,6 +213,19 @@ class MklPardiso:
             a[i0:i1, i0:i1] = np.triu(blk) + np.triu(blk, 1).T
             a[i1:, i0:i1] = a[i0:i1, i1:].T
         return a
+
+    def _lapacke_spd(self, name: str, uplo: bytes, a: np.ndarray) -> None:
+        """``LAPACKE_dpotrf`` / ``dpotri`` in place on the square C array ``a``, read
+        column-major (the transpose: the same matrix for an SPD one)."""
+        fn = getattr(self.lib, name)
+        fn.restype = ctypes.c_int
+        fn.argtypes = [ctypes.c_int, ctypes.c_char, ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
+        n = a.shape[0]
+        info = fn(102, ctypes.c_char(uplo), n, a.ctypes.data, n)  # 102: column-major
+        if info > 0 and name == "LAPACKE_dpotrf":
+            raise SolverError(f"matrix is not positive definite (leading minor {info})")
+        if info != 0:
+            raise SolverError(f"MKL {name} failed: info = {info}")
 
     def spd_cholesky(self, S: np.ndarray) -> np.ndarray:
         """Lower Cholesky factor ``L`` (``S = L Lᵀ``) of a dense SPD matrix by MKL ``dpotrf``, on
@@ -237,14 +240,7 @@ class MklPardiso:
         n = S.shape[0]
         a = np.array(S, dtype=np.float64, order="C", copy=True)
         # Column-major upper factor (S = Uᵀ U) of the C array = row-major lower L = Uᵀ.
-        fn = self.lib.LAPACKE_dpotrf
-        fn.restype = ctypes.c_int
-        fn.argtypes = [ctypes.c_int, ctypes.c_char, ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
-        info = fn(102, ctypes.c_char(b"U"), n, a.ctypes.data, n)
-        if info > 0:
-            raise SolverError(f"matrix is not positive definite (leading minor {info})")
-        if info != 0:
-            raise SolverError(f"MKL LAPACKE_dpotrf failed: info = {info}")
+        self._lapacke_spd("LAPACKE_dpotrf", b"U", a)
         for i0 in range(0, n, 2048):  # zero the strict upper triangle, a block of rows at a time
             i1 = min(i0 + 2048, n)
             a[i0:i1, i0:i1] = np.tril(a[i0:i1, i0:i1])
