@@ -34,7 +34,7 @@ import numpy as np
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
-from fegear.ltca.grid import PairCells, pair_cells
+from fegear.ltca.grid import PairCells, near_cells, pair_cells
 from fegear.ltca.hybrid import hybrid_compliance, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
@@ -269,11 +269,16 @@ def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
 
 
 def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
+    """Could a point left out (separation above ``g_max``) close under the lag ``θ``? Only if
+    its rigid gap ``g − θ h`` is negative (the elastic term ``C F`` opens it further). Tested
+    on the coarse TCA grid points and on every pair's closest point, where the separation is
+    exact (a narrow valley can run between the coarse points: :func:`near_cells`)."""
     for g in pos.grids:
         out = g.valid & (g.separation > g_max)
         if np.any(g.separation[out] - theta * g.h[out] < 0.0):
             return True
-    return False
+    out = pos.pair_valid & (pos.backlash_mm > g_max)
+    return bool(np.any(pos.backlash_rad[out] < theta))
 
 
 def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprints=None):
@@ -284,7 +289,7 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
-            if not np.any(g.valid & (g.separation <= g_max)):
+            if not np.any(near_cells(pos, gi, g_max)):
                 continue
             n = models.pinion.sector.n_teeth
             msg = (

@@ -3,7 +3,8 @@
 The TCA gives, per position and tooth pair, the separation on a coarse grid over the whole
 pinion flank. The loaded analysis needs cells small against the contact patch, but only where
 the separation is below the largest approach the load can produce (``g_max``): the coarse cells
-with separation ``<= g_max`` (dilated by one coarse cell) bound a box in the flank coordinates
+with separation ``<= g_max`` (:func:`near_cells`, dilated by one coarse cell) bound a box in the
+flank coordinates
 ``(u, v)``, which is divided into cells of about ``cell_mm`` and their separations recomputed
 exactly (the pinion normal through the cell centre meets the exact gear flank, as in the TCA).
 
@@ -27,7 +28,7 @@ from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
 
-__all__ = ["PairCells", "pair_cells"]
+__all__ = ["PairCells", "near_cells", "pair_cells"]
 
 Array = NDArray[np.float64]
 _GAUSS2 = np.array([-1.0, 1.0]) / math.sqrt(3.0)
@@ -132,6 +133,36 @@ def _chords(X: Array, axis: int) -> Array:
     return np.concatenate([[0.0], np.cumsum(seg)])
 
 
+def near_cells(pos: PositionResult, grid_index: int, g_max: float) -> NDArray[np.bool_]:
+    """``(nu, nv)`` bool: the coarse cells of the pair ``pos.grids[grid_index]`` whose region
+    may hold a separation ``<= g_max``.
+
+    The coarse grid samples the separation at its cell centres only. A separation valley
+    narrower than a coarse cell (a localized contact's: the loaded patch of the seed face gear is
+    0.5 mm wide, its coarse cells 1.5 × 1.2 mm) can run between the samples with its floor below
+    every one of them, and a pair about to enter would be missed (measured on the seed face gear,
+    φ1 = −3.74°: pair (−1, −1) 8.8 µm from contact at its closest point, every sample above
+    ``g_max`` = 13 µm; it takes 0.5 % of the torque and the loaded TE moves by 0.018″). So the
+    coarse cell holding the pair's closest point (where the TCA solved the separation exactly,
+    ``pos.backlash_mm``) is near too whenever that separation is within ``g_max``.
+    """
+    g = pos.grids[grid_index]
+    near = g.valid & (g.separation <= g_max)
+    ip = int(np.flatnonzero((pos.pairs[:, 0] == g.k) & (pos.pairs[:, 1] == g.j))[0])
+    if pos.pair_valid[ip] and pos.backlash_mm[ip] <= g_max:
+        # the valid cell nearest the closest point (which may lie on a flank edge, where the
+        # normal of the cell around it misses the gear flank), in units of the cell sizes
+        u, v = pos.pinion_uv[ip]
+        du = (g.u[:, None] - u) / max(abs(g.u[-1] - g.u[0]) / max(g.u.size - 1, 1), 1e-300)
+        dv = (g.v[None, :] - v) / max(abs(g.v[-1] - g.v[0]) / max(g.v.size - 1, 1), 1e-300)
+        d2 = np.where(g.valid, du**2 + dv**2, np.inf)
+        iu, iv = np.unravel_index(int(np.argmin(d2)), d2.shape)
+        if np.isfinite(d2[iu, iv]):
+            near = near.copy()
+            near[iu, iv] = True
+    return near
+
+
 def pair_cells(
     tca: TCA,
     pos: PositionResult,
@@ -166,7 +197,7 @@ def pair_cells(
     cu_mm, cv_mm = (cell_mm, cell_mm) if np.isscalar(cell_mm) else cell_mm
     g = pos.grids[grid_index]
     i = int(np.flatnonzero((tca.pairs[:, 0] == g.k) & (tca.pairs[:, 1] == g.j))[0])
-    near = g.valid & (g.separation <= g_max)
+    near = near_cells(pos, grid_index, g_max)
     if not near.any():
         return None
     b = tca.fm1.bounds

@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 from scipy.ndimage import binary_dilation
 
 from fegear.errors import InputError
+from fegear.ltca.grid import near_cells
 from fegear.mesh.sector import FlankZone
 from fegear.tca.results import PositionResult
 
@@ -137,9 +138,10 @@ def contact_zone(
     grids = [g for p in positions for g in p.grids]
     if not grids:
         raise InputError("positions", "without separation grids", "TCA positions with grids")
-    near_pairs = sorted(
-        {(int(g.k), int(g.j)) for g in grids if np.any(g.valid & (g.separation <= gap_mm))}
-    )
+    # (grid, its near cells): the coarse samples within gap_mm and the cell of the pair's
+    # closest point (a narrow valley can run between the samples: near_cells).
+    nears = [(g, near_cells(p, i, gap_mm)) for p in positions for i, g in enumerate(p.grids)]
+    near_pairs = sorted({(int(g.k), int(g.j)) for g, near in nears if np.any(near)})
     reach = max((max(abs(k), abs(j)) for k, j in near_pairs), default=0)
     n = n_teeth if n_teeth is not None else max(min_teeth, 2 * reach + 3)
     c = n // 2
@@ -148,15 +150,14 @@ def contact_zone(
     for k, j in near_pairs:
         if not (0 <= k + c < n and 0 <= j + c < n):
             continue
-        gs = [g for g in grids if (g.k, g.j) == (k, j)]
-        u, v = gs[0].u, gs[0].v
-        m1 = np.zeros(gs[0].valid.shape, dtype=bool)
+        gs = [(g, near) for g, near in nears if (g.k, g.j) == (k, j)]
+        u, v = gs[0][0].u, gs[0][0].v
+        m1 = np.zeros(gs[0][0].valid.shape, dtype=bool)
         nu2, nv2 = m1.shape
         u2 = np.linspace(bounds2.u_fillet, bounds2.u_tip, nu2 + 1)
         v2 = np.linspace(bounds2.v_start, bounds2.v_end, nv2 + 1)
         m2 = np.zeros((nu2, nv2), dtype=bool)
-        for g in gs:
-            near = g.valid & (g.separation <= gap_mm)
+        for g, near in gs:
             m1 |= near
             # gear points of the near cells and their neighbours, rasterised on the gear grid
             around = _dilate(near) & g.valid
