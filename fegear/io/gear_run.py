@@ -247,7 +247,6 @@ def run_gear_case(
         Bad overrides or design data.
     """
     from fegear.ltca import LTCAOptions, build_models, run_ltca
-    from fegear.ltca.analysis import cycle_zone
     from fegear.tca import TCAOptions, reference_phase, run_tca
 
     case = _override(case, fidelity, level)
@@ -294,10 +293,9 @@ def run_gear_case(
         progress=lambda i, n: say("positions", i, n),
     )
     seconds["positions"] = time.perf_counter() - t0
-    if models.zone is not None and cycle.zone_gap_mm > models.zone.gap_mm:
+    if cycle.zone is not None and cycle.zone is not models.zone:
         # the load grew the contact zone: the cycle ran on other sectors (cached, read back)
-        zone = cycle_zone(pair.pinion, pair.gear, pair.assembly, opt, gap_mm=cycle.zone_gap_mm)
-        models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=zone)
+        models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cycle.zone)
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds)
     if case.fidelity == "hertz":  # no contact grid: no cell loads, no displacement fields

@@ -34,7 +34,7 @@ import numpy as np
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
-from fegear.ltca.grid import PairCells, near_cells, pair_cells
+from fegear.ltca.grid import PairCells, pair_cells
 from fegear.ltca.hybrid import hybrid_compliance, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
@@ -44,7 +44,7 @@ from fegear.ltca.model import (
 )
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.warm import active_guess, footprint
-from fegear.ltca.zone import ContactZone, contact_zone
+from fegear.ltca.zone import ContactZone, contact_zone, left_out_pairs
 from fegear.mesh.sector import FINE, sector_mesh
 from fegear.patch import measure_patch
 from fegear.tca import TCA, TCAOptions
@@ -166,14 +166,20 @@ class MemberModels:
 
 
 def cycle_zone(
-    pinion, gear, assembly, options: LTCAOptions, gap_mm: float | None = None
+    pinion,
+    gear,
+    assembly,
+    options: LTCAOptions,
+    gap_mm: float | None = None,
+    exact: bool = False,
 ) -> ContactZone:
     """The contact zone (:func:`fegear.ltca.zone.contact_zone`) of the default cycle of
     ``_ZONE_POSITIONS`` positions (the TCA comes from its cache), with the separation bound
-    ``gap_mm`` (default ``g_max``, where the contact grids start; when a load makes ``g_max``
-    grow past it so that a pair outside the zone could touch, :func:`fegear.ltca.run_ltca`
-    rebuilds the sectors on the zone of the grown bound). The zone does not depend on the
-    positions asked for, so every run on the pair shares the meshes."""
+    ``gap_mm`` (default ``g_max``, where the contact grids start). The first zone is the sampled
+    one (``exact=False``); when a pair outside it can close under the solved lag,
+    :func:`fegear.ltca.run_ltca` rebuilds the sectors on the exact zone of the grown bound
+    (:func:`fegear.ltca.cycle.grown_zone`). The zone does not depend on the positions asked
+    for, so every run on the pair shares the meshes."""
     n = _ZONE_POSITIONS
     tca_opt = TCAOptions(
         n_positions=n, separation_grid=options.tca_grid, E_MPa=options.E_MPa, nu=options.nu
@@ -188,6 +194,7 @@ def cycle_zone(
         assembly.side2,
         options.g_max_mm if gap_mm is None else gap_mm,
         n_teeth=options.n_teeth,
+        exact=exact,
     )
 
 
@@ -289,17 +296,7 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
-            if not np.any(near_cells(pos, gi, g_max)):
-                continue
-            n = models.pinion.sector.n_teeth
-            msg = (
-                f"pair ({g.k}, {g.j}) could touch (separation <= {g_max:.3g} mm) but lies "
-                f"outside the contact zone of the {n}-tooth sectors: not modelled"
-            )
-            if msg not in warnings:
-                warnings.append(msg)
-                log.warning(msg)
-            continue
+            continue  # outside the zone: reported by _left_out if the lag can close it
         su, sv, angle = cell.get((int(g.k), int(g.j)), cell[None])
         cap = models.max_cells if models.fidelity == "hybrid" else _FE_MAX_CELLS
         c = pair_cells(tca, pos, gi, (su, sv), g_max, max_cells=cap, angle=angle)
@@ -432,6 +429,7 @@ def solve_position(
                 contact_point=centroid,
             )
         )
+    left = left_out_pairs(pos, models, sol.theta, warnings)
     te_l = pos.te_arcsec - sol.theta / ARCSEC
     return LoadedPosition(
         phi1=pos.phi1,
@@ -444,4 +442,5 @@ def solve_position(
         solution=sol,
         g_max_mm=g_max,
         warnings=tuple(warnings),
+        left_out=left,
     )

@@ -204,12 +204,12 @@ def run_ltca(
     }
     out = _solve_all(job, parts, workers, progress)
     for _ in range(3):
-        grown = grown_zone(pinion, gear, assembly, opt, models, out)
+        grown = grown_zone(pinion, gear, assembly, opt, models, out, tca_pos)
         if grown is None:
             break
         log.warning(
-            "g_max grew to %.3g mm: a pair outside the contact zone of the sectors can touch; "
-            "rebuilding them on the zone of that bound (pairs %s) and solving again",
+            "the loaded lag closes a pair outside the contact zone of the sectors; rebuilding "
+            "them on the exact zone within %.3g mm (pairs %s) and solving again",
             grown.gap_mm,
             [tuple(int(x) for x in p) for p in grown.pairs],
         )
@@ -230,34 +230,44 @@ def run_ltca(
         seconds=seconds,
         phase2=float(asm.phase2),
         zone_gap_mm=float(models.zone.gap_mm) if models.zone is not None else 0.0,
+        zone=models.zone,
     )
 
 
 def grown_zone(
-    pinion, gear, assembly, opt: LTCAOptions, models: MemberModels, solved: list[LoadedPosition]
+    pinion,
+    gear,
+    assembly,
+    opt: LTCAOptions,
+    models: MemberModels,
+    solved: list[LoadedPosition],
+    positions=None,
 ) -> ContactZone | None:
     """The contact zone the solved positions need, if the models' zone is too small for them.
 
-    A load whose elastic approach exceeds the zone's separation bound makes ``g_max`` grow past
-    it (:func:`fegear.ltca.analysis.solve_position`); pairs that could then touch but lie outside
-    the zone teeth were left out (and reported). Returns the cycle zone at the largest ``g_max``
-    used when it brings such a pair into the model, else None (also when the zone could not grow:
-    a fixed ``n_teeth`` too small for the pair).
+    The first zone is the sampled one at ``g_max`` (:func:`fegear.ltca.analysis.cycle_zone`). A
+    pair outside its teeth that the solved lag closes (``LoadedPosition.left_out``: its angular
+    gap at its closest point is below the lag) must be modelled: returns the exact zone
+    (``exact=True``) at the largest separation bound the solve used (``g_max``, which
+    :func:`fegear.ltca.analysis.solve_position` raises past every closest point the lag closes,
+    and at least the closest points of the pairs left out, from the TCA ``positions``), when it
+    brings every such pair into the model; else None (nothing left out, or a fixed ``n_teeth``
+    too small for the pair: reported per position).
     """
     if models.zone is None:
         return None
-    g_used = max((p.g_max_mm for p in solved), default=0.0)
-    if g_used <= models.zone.gap_mm:
+    missing = sorted({q for p in solved for q in p.left_out})
+    if not missing:
         return None
-    zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=g_used)
+    gap = max([models.zone.gap_mm] + [p.g_max_mm for p in solved])
+    for pos in positions or ():
+        for (k, j), ok, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
+            if ok and (int(k), int(j)) in missing:
+                gap = max(gap, float(b))
+    zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=gap, exact=True)
     c = zone.n_teeth // 2
     teeth1 = {z.tooth - c for z in zone.pinion}
     teeth2 = {z.tooth - c for z in zone.gear}
-    missing = [
-        (int(k), int(j))
-        for k, j in zone.pairs
-        if not (models.pinion.has_tooth(int(k)) and models.gear.has_tooth(int(j)))
-    ]
-    if not missing or not all(k in teeth1 and j in teeth2 for k, j in missing):
+    if not all(k in teeth1 and j in teeth2 for k, j in missing):
         return None
     return zone

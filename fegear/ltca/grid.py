@@ -149,7 +149,9 @@ def near_cells(pos: PositionResult, grid_index: int, g_max: float) -> NDArray[np
     g = pos.grids[grid_index]
     near = g.valid & (g.separation <= g_max)
     ip = int(np.flatnonzero((pos.pairs[:, 0] == g.k) & (pos.pairs[:, 1] == g.j))[0])
-    if pos.pair_valid[ip] and pos.backlash_mm[ip] <= g_max:
+    # (backlash_mm is 0 where the TCA's normal missed the gear flank: unknown, not touching)
+    known = pos.backlash_mm[ip] > 0.0 or pos.backlash_rad[ip] <= 0.0
+    if pos.pair_valid[ip] and known and pos.backlash_mm[ip] <= g_max:
         # the valid cell nearest the closest point (which may lie on a flank edge, where the
         # normal of the cell around it misses the gear flank), in units of the cell sizes
         u, v = pos.pinion_uv[ip]

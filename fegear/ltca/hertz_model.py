@@ -41,6 +41,7 @@ from fegear.halfspace import subsurface_influence
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
 from fegear.ltca.grid import _separation, pair_cells
 from fegear.ltca.results import LoadedPosition, PairLoad
+from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
 from fegear.tca.results import ARCSEC, PositionResult
 
@@ -274,6 +275,7 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
         max_penetration=0.0,
         min_active_force=float(F[F > 0].min()) if np.any(F > 0) else 0.0,
     )
+    left = left_out_pairs(pos, models, float(theta), warnings)
     te_l = pos.te_arcsec - theta / ARCSEC
     return LoadedPosition(
         phi1=pos.phi1,
@@ -286,4 +288,5 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
         solution=sol,
         g_max_mm=0.0,
         warnings=tuple(warnings),
+        left_out=left,
     )

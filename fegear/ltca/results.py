@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from fegear.contact import ContactSolution
 from fegear.ltca.grid import PairCells
+from fegear.ltca.zone import ContactZone
 
 __all__ = ["PairLoad", "LoadedPosition", "LoadedCycle"]
 
@@ -90,6 +91,9 @@ class LoadedPosition:
         Separation cut-off used for the cells.
     warnings
         Human-readable warnings (e.g. a grid coarser than the patch).
+    left_out
+        Pairs ``(k, j)`` the lag closes that lie outside the modelled teeth (the cycle grows its
+        zone to hold them: :func:`fegear.ltca.cycle.grown_zone`).
     """
 
     phi1: float
@@ -102,6 +106,7 @@ class LoadedPosition:
     solution: ContactSolution
     g_max_mm: float
     warnings: tuple[str, ...]
+    left_out: tuple[tuple[int, int], ...] = ()
 
     @property
     def n_pairs_in_contact(self) -> int:
@@ -139,6 +144,9 @@ class LoadedCycle:
         mm, the separation bound of the contact zone the sectors were built on (larger than
         ``g_max`` when the load made the zone grow, :func:`fegear.ltca.cycle.grown_zone`); 0 for
         models without a zone.
+    zone
+        That contact zone (:class:`fegear.ltca.zone.ContactZone`; the models of the cycle are
+        ``build_models(..., zone=zone)``, read back from the cache), or None.
     """
 
     positions: tuple[LoadedPosition, ...]
@@ -152,6 +160,7 @@ class LoadedCycle:
     seconds: dict[str, float]
     phase2: float = 0.0
     zone_gap_mm: float = 0.0
+    zone: ContactZone | None = None
 
     @property
     def te_pp_unloaded_arcsec(self) -> float:

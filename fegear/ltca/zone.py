@@ -8,6 +8,16 @@ separation is at most ``gap_mm`` (the loaded approach cannot close more). The se
 gets ``n = 2 max(|k|, |j|) + 3`` teeth (at least ``min_teeth``), so every such tooth has a
 neighbour on each side and the sector stays symmetric about member tooth 0.
 
+**Which pairs.** ``exact=True``: a pair is in when its separation is within ``gap_mm`` anywhere
+(the coarse samples, or its closest point, where the TCA solved it exactly:
+:func:`fegear.ltca.grid.near_cells`; a separation valley narrower than a coarse cell can run
+between the samples). ``exact=False``: the coarse samples only. The loaded analysis starts from
+the sampled zone (a proxy of the reach of the load: on the seed face gear pair (1, 1) comes
+within 17.8 µm of contact at its closest point, every sample reads more than 22.9 µm, and the
+rated load closes 9.5 µm: modelling it would double the cost of the operators for nothing) and
+grows it with the exact rule when a pair left out can close under the solved lag
+(:func:`fegear.ltca.cycle.grown_zone`).
+
 **Zone.** On every such tooth, the TCA's coarse separation cells (a regular grid of the pinion
 flank coordinates) with separation ``<= gap_mm`` at any position, dilated by one coarse cell in
 both directions (the same dilation as the contact grids of :func:`fegear.ltca.grid.pair_cells`),
@@ -45,7 +55,7 @@ from fegear.ltca.grid import near_cells
 from fegear.mesh.sector import FlankZone
 from fegear.tca.results import PositionResult
 
-__all__ = ["ContactZone", "contact_zone"]
+__all__ = ["left_out_pairs", "ContactZone", "contact_zone"]
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
@@ -116,6 +126,7 @@ def contact_zone(
     gap_mm: float,
     n_teeth: int | None = None,
     min_teeth: int = 3,
+    exact: bool = True,
 ) -> ContactZone:
     """The contact zone of a cycle (see the module docstring).
 
@@ -134,13 +145,20 @@ def contact_zone(
         zone (the loaded analysis reports them).
     min_teeth
         Fewest teeth of an automatic count.
+    exact
+        Pairs and cells within ``gap_mm`` at their exact closest points too, not only at the
+        coarse samples (see the module docstring).
     """
     grids = [g for p in positions for g in p.grids]
     if not grids:
         raise InputError("positions", "without separation grids", "TCA positions with grids")
-    # (grid, its near cells): the coarse samples within gap_mm and the cell of the pair's
-    # closest point (a narrow valley can run between the samples: near_cells).
-    nears = [(g, near_cells(p, i, gap_mm)) for p in positions for i, g in enumerate(p.grids)]
+    # (grid, its near cells): the coarse samples within gap_mm and, if exact, the cell of the
+    # pair's closest point (a narrow valley can run between the samples: near_cells).
+    nears = [
+        (g, near_cells(p, i, gap_mm) if exact else g.valid & (g.separation <= gap_mm))
+        for p in positions
+        for i, g in enumerate(p.grids)
+    ]
     near_pairs = sorted({(int(g.k), int(g.j)) for g, near in nears if np.any(near)})
     reach = max((max(abs(k), abs(j)) for k, j in near_pairs), default=0)
     n = n_teeth if n_teeth is not None else max(min_teeth, 2 * reach + 3)
@@ -183,3 +201,32 @@ def contact_zone(
         pairs=np.array(near_pairs, dtype=np.int64).reshape(-1, 2),
         gap_mm=float(gap_mm),
     )
+
+
+def left_out_pairs(
+    pos: PositionResult, models, theta: float, warnings: list[str] | None = None
+) -> tuple[tuple[int, int], ...]:
+    """The pairs outside the modelled teeth that the lag ``θ`` (rad) closes at ``pos``.
+
+    A pair closes under the rigid rotation ``θ`` of member 2 where its angular gap
+    ``backlash_rad`` (exact, at its closest point) is below ``θ``; the elastic deformation only
+    opens it further. ``models`` has ``pinion.has_tooth(k)`` and ``gear.has_tooth(j)``
+    (:class:`fegear.ltca.analysis.MemberModels`). Each pair found is appended to ``warnings``
+    (and logged); :func:`fegear.ltca.cycle.grown_zone` rebuilds the sectors to hold it.
+    """
+    out = tuple(
+        (int(k), int(j))
+        for (k, j), ok, b in zip(pos.pairs, pos.pair_valid, pos.backlash_rad, strict=True)
+        if ok
+        and b < theta
+        and not (models.pinion.has_tooth(int(k)) and models.gear.has_tooth(int(j)))
+    )
+    for k, j in out:
+        msg = (
+            f"pair ({k}, {j}) closes under the loaded lag but lies outside the contact zone of "
+            f"the {models.pinion.sector.n_teeth}-tooth sectors: not modelled"
+        )
+        if warnings is not None and msg not in warnings:
+            warnings.append(msg)
+            log.warning("phi1 = %.4f: %s", pos.phi1, msg)
+    return out
