@@ -296,7 +296,7 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
     cells: list[PairCells] = []
     for gi, g in enumerate(pos.grids):
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
-            continue  # outside the zone: reported by _left_out if the lag can close it
+            continue  # outside the zone: left_out_pairs reports it if the lag closes it
         su, sv, angle = cell.get((int(g.k), int(g.j)), cell[None])
         cap = models.max_cells if models.fidelity == "hybrid" else _FE_MAX_CELLS
         c = pair_cells(tca, pos, gi, (su, sv), g_max, max_cells=cap, angle=angle)

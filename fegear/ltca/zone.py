@@ -55,7 +55,7 @@ from fegear.ltca.grid import near_cells
 from fegear.mesh.sector import FlankZone
 from fegear.tca.results import PositionResult
 
-__all__ = ["left_out_pairs", "ContactZone", "contact_zone"]
+__all__ = ["ContactZone", "contact_zone", "left_out_pairs"]
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
