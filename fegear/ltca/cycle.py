@@ -247,23 +247,38 @@ def grown_zone(
 
     The first zone is the sampled one at ``g_max`` (:func:`fegear.ltca.analysis.cycle_zone`). A
     pair outside its teeth that the solved lag closes (``LoadedPosition.left_out``: its angular
-    gap at its closest point is below the lag) must be modelled: returns the exact zone
-    (``exact=True``) at the largest separation bound the solve used (``g_max``, which
-    :func:`fegear.ltca.analysis.solve_position` raises past every closest point the lag closes,
-    and at least the closest points of the pairs left out, from the TCA ``positions``), when it
-    brings every such pair into the model; else None (nothing left out, or a fixed ``n_teeth``
-    too small for the pair: reported per position).
+    gap at its closest point is below the lag ``θ``) must be modelled: returns the exact zone
+    (``exact=True``) within the reach of the load, when it brings every such pair into the
+    model; else None (nothing left out, or a fixed ``n_teeth`` too small for the pair: reported
+    per position).
+
+    The reach is the rigid approach the solved lag can produce, with the margin of the
+    ``hybrid`` grids: ``1.5 θ_p ℓ_p`` at each position ``p``, ``ℓ_p`` the largest lever
+    ``backlash_mm / backlash_rad`` of its pairs (the TCA ``positions``), and at least the
+    closest point of each pair where it was left out and the models' own gap. The elastic
+    deformation only opens a gap further, so no point beyond the reach can touch. Without the
+    TCA positions, the largest ``g_max`` the solves used. (Session 6 took the largest ``g_max``
+    and the closest points of the left-out pairs at every position of the cycle, where they
+    are far from contact: on the seed face gear at 6e6 N·mm, ``hertz`` level 0, 0.0675 mm, and
+    the fine zone of every loaded tooth grew with it.)
     """
     if models.zone is None:
         return None
     missing = sorted({q for p in solved for q in p.left_out})
     if not missing:
         return None
-    gap = max([models.zone.gap_mm] + [p.g_max_mm for p in solved])
-    for pos in positions or ():
-        for (k, j), ok, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
-            if ok and (int(k), int(j)) in missing:
-                gap = max(gap, float(b))
+    if positions is None:
+        gap = max([models.zone.gap_mm] + [p.g_max_mm for p in solved])
+    else:
+        gap = models.zone.gap_mm
+        for p, pos in zip(solved, positions, strict=True):
+            ok = np.asarray(pos.pair_valid, dtype=bool) & (np.asarray(pos.backlash_rad) > 0)
+            if ok.any() and p.theta > 0:
+                lever = np.asarray(pos.backlash_mm)[ok] / np.asarray(pos.backlash_rad)[ok]
+                gap = max(gap, 1.5 * p.theta * float(lever.max()))
+            for (k, j), v, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
+                if v and (int(k), int(j)) in p.left_out:
+                    gap = max(gap, float(b))
     zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=gap, exact=True)
     c = zone.n_teeth // 2
     teeth1 = {z.tooth - c for z in zone.pinion}
