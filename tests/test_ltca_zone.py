@@ -127,3 +127,48 @@ def test_a_load_beyond_the_zone_grows_it_and_models_the_new_pair():
     for p in c.positions:
         # torque balance, enforced by the contact solve up to round-off: the shares add up to one
         assert sum(q.load_share for q in p.pairs) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_the_grown_zone_reaches_as_far_as_the_lag_can_close(monkeypatch):
+    """The rebuilt zone's gap is the rigid approach the solved lag can produce, ``1.5 θ ℓ`` (ℓ the
+    largest lever of a position's pairs), and the closest point of a left-out pair where it was
+    left out; not that pair's closest point at the positions where it is far from contact (the
+    session-6 rule took those and grew the fine zone of every loaded tooth with them)."""
+    from types import SimpleNamespace
+
+    from fegear.ltca import cycle as cyc
+
+    seen = []
+
+    def fake_zone(pinion, gear, assembly, opt, gap_mm, exact):
+        seen.append((gap_mm, exact))
+        boxes = tuple(SimpleNamespace(tooth=2 + t) for t in (-1, 0, 1))
+        return SimpleNamespace(n_teeth=5, pinion=boxes, gear=boxes, gap_mm=gap_mm)
+
+    monkeypatch.setattr(cyc, "cycle_zone", fake_zone)
+    models = SimpleNamespace(zone=SimpleNamespace(gap_mm=0.02))
+    pairs = np.array([[0, 0], [1, 1]])
+    lever = 500.0  # mm
+    # position 0: pair (1, 1) 15 µm away and left out by a lag of 4e-5 rad (20 µm at the lever);
+    # position 1: the same pair 80 µm away, not closed, lag 3e-5 rad
+    tca = [
+        SimpleNamespace(
+            pairs=pairs,
+            pair_valid=np.array([True, True]),
+            backlash_mm=np.array([0.0, b]),
+            backlash_rad=np.array([0.0, b / lever]),
+        )
+        for b in (0.015, 0.080)
+    ]
+    solved = [
+        SimpleNamespace(theta=4e-5, left_out=((1, 1),), g_max_mm=0.1),
+        SimpleNamespace(theta=3e-5, left_out=(), g_max_mm=0.1),
+    ]
+    z = cyc.grown_zone(None, None, None, None, models, solved, tca)
+    assert z is not None and seen[-1][1] is True
+    # 1.5 x 4e-5 rad x 500 mm = 0.030 mm: the reach of position 0; neither the 0.080 mm of the
+    # far position nor the g_max of 0.1 mm the solves used
+    assert seen[-1][0] == pytest.approx(1.5 * 4e-5 * lever, rel=1e-12)
+    # nothing left out: no rebuild
+    solved_ok = [SimpleNamespace(theta=4e-5, left_out=(), g_max_mm=0.1)] * 2
+    assert cyc.grown_zone(None, None, None, None, models, solved_ok, tca) is None
