@@ -266,6 +266,12 @@ def test_fzg_run_writes_the_summary_keys(fzg_run):
                 assert q["contact_point_mm"] is None
     assert doc["versions"]["fegear"] and doc["timings_s"]["models"] > 0
     assert doc["units"]["pressure"] == "MPa"
+    # what the sectors modelled: every pair in contact at some position has a fine zone, and
+    # 5 teeth hold the pairs -1, 0, +1 of a contact ratio of 1.46 with a neighbour each side
+    zone = _get(doc, "cycle.contact_zone")
+    modelled = {tuple(p) for p in zone["pairs"]}
+    touching = {(q["pinion_tooth"], q["gear_tooth"]) for p in doc["positions"] for q in p["pairs"]}
+    assert touching <= modelled and zone["sector_teeth"] == 5 and zone["gap_mm"] > 0
     assert _get(doc, "cycle.p_max_MPa") == pytest.approx(
         max(q["p_max_MPa"] for p in doc["positions"] for q in p["pairs"]), rel=1e-12
     )

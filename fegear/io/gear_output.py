@@ -9,7 +9,8 @@ Files written to the output folder (each one atomically: complete or absent):
   ``cycle.contact_ratio_loaded``, ``cycle.p_max_MPa``, ``positions[i].pinion_angle_deg``,
   ``positions[i].te_loaded_arcsec``, ``positions[i].pairs[j].load_share``,
   ``positions[i].pairs[j].p_max_MPa``, ``positions[i].pairs[j].contact_point_mm``,
-  ``positions[i].pairs[j].edge_contact``. (Fidelity ``tca``: the loaded values are ``null``.)
+  ``positions[i].pairs[j].edge_contact``, ``cycle.contact_zone`` (``sector_teeth``, ``pairs``,
+  ``gap_mm``: what the sectors modelled). (Fidelity ``tca``: the loaded values are ``null``.)
 - ``vtk/pinion_<i>.vtu``, ``vtk/gear_<i>.vtu`` (fidelity ``fe``) — the sector of each member
   in its assembled position at position ``i`` (fixed frame, mm; the gear at its unloaded
   TCA-closed angle ``ratio·φ1 + TE_unloaded``, the elastic lag is not added), linear tets, with
@@ -182,6 +183,14 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
             ),
             "max_penetration_mm": max((s.max_penetration for s in sols), default=0.0),
         }
+        if c.zone is not None:
+            # What the sectors modelled: their teeth, the pairs with a fine zone and the
+            # separation bound of that zone (larger than the case's g_max when the load grew it).
+            doc["cycle"]["contact_zone"] = {
+                "sector_teeth": int(c.zone.n_teeth),
+                "pairs": [[int(k), int(j)] for k, j in np.asarray(c.zone.pairs).tolist()],
+                "gap_mm": float(c.zone.gap_mm),
+            }
         doc["positions"] = _fe_positions(run)
         doc["mesh"] = {
             mf.name: {
