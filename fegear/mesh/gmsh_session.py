@@ -6,14 +6,26 @@ without ``interruptible``). Python ignores SIGPIPE so that a write to a closed p
 ``BrokenPipeError``; with the default action the process dies silently instead (exit 141). That
 killed the test session when a worker process of the loaded cycle had gone and the executor wrote
 to its pipe. :func:`initialize` starts gmsh and puts the SIGPIPE disposition back.
+
+Some of gmsh's 3-D meshers print straight to the C streams, past ``General.Terminal = 0`` (seen:
+"Found two exactly self-intersecting facets" when HXT gives up on a sector and the next
+algorithm takes over). A library must not print: :func:`native_output_to_log` sends what the C
+code writes to file descriptors 1 and 2 during a call to the log instead.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import logging
+import os
 import signal
+import sys
+import tempfile
 import threading
+from collections.abc import Iterator
 
-__all__ = ["initialize"]
+__all__ = ["initialize", "native_output_to_log"]
 
 
 def initialize() -> None:
@@ -26,3 +38,39 @@ def initialize() -> None:
     if main and before is not None:
         # Python caches its view of the handler; re-installing it calls sigaction again.
         signal.signal(signal.SIGPIPE, before)
+
+
+def _flush_c_stdio() -> None:
+    """Flush the C library's stdio buffers (output redirected to a file is block-buffered)."""
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # pragma: no cover - no C runtime symbol lookup here
+        pass
+
+
+@contextlib.contextmanager
+def native_output_to_log(
+    log: logging.Logger, level: int = logging.DEBUG, prefix: str = "gmsh: "
+) -> Iterator[None]:
+    """Capture what native code writes to file descriptors 1 and 2 inside the block and log it,
+    one record per non-empty line, after the block (also when it raises)."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    _flush_c_stdio()
+    with tempfile.TemporaryFile() as tmp:
+        saved = [os.dup(1), os.dup(2)]
+        try:
+            os.dup2(tmp.fileno(), 1)
+            os.dup2(tmp.fileno(), 2)
+            yield
+        finally:
+            _flush_c_stdio()
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+            tmp.seek(0)
+            for line in tmp.read().decode("utf-8", "replace").splitlines():
+                if line.strip():
+                    log.log(level, "%s%s", prefix, line.rstrip())

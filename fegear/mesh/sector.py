@@ -65,6 +65,7 @@ from ..errors import InputError, MeshError
 from ..geometry.surface import GeneratedMember, Side
 from .cache import cache_dir, cached_file, content_hash
 from .gmsh_session import initialize as initialize_gmsh
+from .gmsh_session import native_output_to_log
 from .sector_geometry import (
     SectorFrame,
     flank_distance,
@@ -484,7 +485,8 @@ def _attempt(
         gmsh.option.setNumber("Mesh.Algorithm", alg2)
         gmsh.option.setNumber("Mesh.Algorithm3D", alg3)
         try:
-            gmsh.model.mesh.generate(3)
+            with native_output_to_log(log):
+                gmsh.model.mesh.generate(3)
         except Exception as exc:  # gmsh raises a bare Exception
             raise _AttemptFailed(f"2D/3D algorithms {alg2}/{alg3}: {exc}") from exc
         tags, _ = gmsh.model.mesh.getElementsByType(4)
