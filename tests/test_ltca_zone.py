@@ -132,8 +132,9 @@ def test_a_load_beyond_the_zone_grows_it_and_models_the_new_pair():
 def test_the_grown_zone_reaches_as_far_as_the_lag_can_close(monkeypatch):
     """The rebuilt zone's gap is the rigid approach the solved lag can produce, ``1.5 θ ℓ`` (ℓ the
     largest lever of a position's pairs), and the closest point of a left-out pair where it was
-    left out; not that pair's closest point at the positions where it is far from contact (the
-    session-6 rule took those and grew the fine zone of every loaded tooth with them)."""
+    left out, rounded up to a ladder of bounds; not that pair's closest point at the positions
+    where it is far from contact (the session-6 rule took those and grew the fine zone of every
+    loaded tooth with them)."""
     from types import SimpleNamespace
 
     from fegear.ltca import cycle as cyc
@@ -167,8 +168,14 @@ def test_the_grown_zone_reaches_as_far_as_the_lag_can_close(monkeypatch):
     z = cyc.grown_zone(None, None, None, None, models, solved, tca)
     assert z is not None and seen[-1][1] is True
     # 1.5 x 4e-5 rad x 500 mm = 0.030 mm: the reach of position 0; neither the 0.080 mm of the
-    # far position nor the g_max of 0.1 mm the solves used
-    assert seen[-1][0] == pytest.approx(1.5 * 4e-5 * lever, rel=1e-12)
+    # far position nor the g_max of 0.1 mm the solves used. Rounded up to the ladder
+    # 0.01 mm x sqrt(2)^k so that nearby loads share the rebuilt sectors: 0.02 sqrt(2) = 0.0283
+    # < 0.030 <= 0.04 mm
+    assert seen[-1][0] == pytest.approx(0.04, rel=1e-12)
+    # a load 10 % higher reaches 0.033 mm: the same zone, so the same cached sectors
+    solved[0] = SimpleNamespace(theta=4.4e-5, left_out=((1, 1),), g_max_mm=0.1)
+    cyc.grown_zone(None, None, None, None, models, solved, tca)
+    assert seen[-1][0] == seen[-2][0]
     # nothing left out: no rebuild
     solved_ok = [SimpleNamespace(theta=4e-5, left_out=(), g_max_mm=0.1)] * 2
     assert cyc.grown_zone(None, None, None, None, models, solved_ok, tca) is None

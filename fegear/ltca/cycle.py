@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import math
 import multiprocessing
 import os
 import time
@@ -234,6 +235,17 @@ def run_ltca(
     )
 
 
+#: Grown zone gaps are rounded up to ``_LADDER_MM · √2^k``: runs at nearby loads (a torque sweep)
+#: then grow to the same zone and share its cached sectors and operators.
+_LADDER_MM = 0.01
+
+
+def _on_ladder(gap_mm: float) -> float:
+    """The smallest ``0.01 mm · √2^k`` (k integer) at or above ``gap_mm`` (at most √2 wider)."""
+    k = math.ceil(2.0 * math.log2(gap_mm / _LADDER_MM) - 1e-9)
+    return _LADDER_MM * math.sqrt(2.0) ** k
+
+
 def grown_zone(
     pinion,
     gear,
@@ -256,8 +268,10 @@ def grown_zone(
     ``hybrid`` grids: ``1.5 θ_p ℓ_p`` at each position ``p``, ``ℓ_p`` the largest lever
     ``backlash_mm / backlash_rad`` of its pairs (the TCA ``positions``), and at least the
     closest point of each pair where it was left out and the models' own gap. The elastic
-    deformation only opens a gap further, so no point beyond the reach can touch. Without the
-    TCA positions, the largest ``g_max`` the solves used. (Session 6 took the largest ``g_max``
+    deformation only opens a gap further, so no point beyond the reach can touch. The gap is
+    rounded up to the ladder ``0.01 mm · √2^k`` (:func:`_on_ladder`) so that nearby loads share
+    the rebuilt sectors in the cache. Without the TCA positions, the largest ``g_max`` the solves
+    used. (Session 6 took the largest ``g_max``
     and the closest points of the left-out pairs at every position of the cycle, where they
     are far from contact: on the seed face gear at 6e6 N·mm, ``hertz`` level 0, 0.0675 mm, and
     the fine zone of every loaded tooth grew with it.)
@@ -279,6 +293,7 @@ def grown_zone(
             for (k, j), v, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
                 if v and (int(k), int(j)) in p.left_out:
                     gap = max(gap, float(b))
+        gap = max(models.zone.gap_mm, _on_ladder(gap))
     zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=gap, exact=True)
     c = zone.n_teeth // 2
     teeth1 = {z.tooth - c for z in zone.pinion}
