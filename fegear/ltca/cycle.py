@@ -242,6 +242,8 @@ _LADDER_MM = 0.01
 
 def _on_ladder(gap_mm: float) -> float:
     """The smallest ``0.01 mm · √2^k`` (k integer) at or above ``gap_mm`` (at most √2 wider)."""
+    if not gap_mm > 0.0:
+        return gap_mm
     k = math.ceil(2.0 * math.log2(gap_mm / _LADDER_MM) - 1e-9)
     return _LADDER_MM * math.sqrt(2.0) ** k
 
