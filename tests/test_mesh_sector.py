@@ -232,3 +232,27 @@ def test_native_output_goes_to_the_log_not_the_terminal():
     # (the C stream is flushed when the block ends, so it may come after the direct write)
     assert sorted(lines[1:-1]) == ["LOG gmsh: from C stdout", "LOG gmsh: from fd 2"]
     assert res.stderr == ""
+
+
+def test_a_flat_surface_triangle_is_remeshed_and_hxt_meshes_the_sector_first_time():
+    """The face gear of the Δγ = −0.02° case (fe level 0, its contact zone): gmsh's surface mesher
+    closed the outer face end at the 0.8 mm wide top land with a triangle on the three collinear
+    nodes of that edge; HXT then stopped ("two exactly self-intersecting facets") and the sector
+    needed a second, slower attempt with another surface algorithm. The flat triangle is now found
+    after the surface mesh and re-meshed with one segment on those short edges: one attempt,
+    HXT, and a valid mesh."""
+    from fegear.case import load_case
+    from fegear.io.gear_case import build_pair
+    from fegear.ltca import LTCAOptions
+    from fegear.ltca.analysis import cycle_zone
+
+    repo = Path(__file__).resolve().parents[1]
+    case = load_case(repo / "cases" / "face_gear_dgamma_minus.toml")
+    pair = build_pair(case)
+    opt = LTCAOptions(level=0, n_teeth=case.n_teeth, E_MPa=case.E_MPa, nu=case.nu)
+    zone = cycle_zone(pair.pinion, pair.gear, pair.assembly, opt)
+    sm = sector_mesh(pair.gear, zone.n_teeth, 0, zone=zone.gear)
+    d = sm.diagnostics  # how the mesh was made (kept beside it in the cache)
+    assert d["attempts"] == 1 and d["algorithm3d"] == 10  # HXT, first time
+    assert d["flat_triangles_fixed"] >= 1  # ... because the flat triangle was re-meshed
+    assert d["min_sicn"] >= 0.03  # the quality every sector must have
