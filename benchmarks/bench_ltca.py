@@ -108,8 +108,8 @@ def main() -> None:
             f"| {r['fidelity']} | {r['level']} | {r['dofs'][0]}, {r['dofs'][1]} | "
             f"{r['t_cold']:.1f} "
             f"({r['t_models']:.1f}) | {r['t_warm_other_torque']:.1f} "
-            f"({r.get('models_s_6e6', float('nan')):.1f}) | "
-            f"{', '.join(f'{g:.4f}' for g in r.get('zone_gap_mm', []))} | {r['rss_MB']:.0f} | "
+            f"({r['models_s_6e6']:.1f}) | "
+            f"{', '.join(f'{g:.4f}' for g in r['zone_gap_mm'])} | {r['rss_MB']:.0f} | "
             f"{a['te_pp_loaded']:.3f} | {a['te_mean_loaded']:.3f} | {a['contact_ratio']:.2f} | "
             f"{a['p_max']:.0f} | {b['te_pp_loaded']:.3f} | {b['contact_ratio']:.2f} |"
         )

@@ -255,7 +255,7 @@ def grown_zone(
     opt: LTCAOptions,
     models: MemberModels,
     solved: list[LoadedPosition],
-    positions=None,
+    positions: list,
 ) -> ContactZone | None:
     """The contact zone the solved positions need, if the models' zone is too small for them.
 
@@ -272,30 +272,27 @@ def grown_zone(
     closest point of each pair where it was left out and the models' own gap. The elastic
     deformation only opens a gap further, so no point beyond the reach can touch. The gap is
     rounded up to the ladder ``0.01 mm · √2^k`` (:func:`_on_ladder`) so that nearby loads share
-    the rebuilt sectors in the cache. Without the TCA positions, the largest ``g_max`` the solves
-    used. (Session 6 took the largest ``g_max``
-    and the closest points of the left-out pairs at every position of the cycle, where they
-    are far from contact: on the seed face gear at 6e6 N·mm, ``hertz`` level 0, 0.0675 mm, and
-    the fine zone of every loaded tooth grew with it.)
+    the rebuilt sectors in the cache. (Session 6 took the largest ``g_max`` and the closest
+    points of the left-out pairs at every position of the cycle, where they are far from
+    contact: on the seed face gear at 6e6 N·mm, ``hertz`` level 0, 0.0675 mm, and the fine zone
+    of every loaded tooth grew with it.) ``positions``: the TCA positions ``solved`` came from,
+    in the same order.
     """
     if models.zone is None:
         return None
     missing = sorted({q for p in solved for q in p.left_out})
     if not missing:
         return None
-    if positions is None:
-        gap = max([models.zone.gap_mm] + [p.g_max_mm for p in solved])
-    else:
-        gap = models.zone.gap_mm
-        for p, pos in zip(solved, positions, strict=True):
-            ok = np.asarray(pos.pair_valid, dtype=bool) & (np.asarray(pos.backlash_rad) > 0)
-            if ok.any() and p.theta > 0:
-                lever = np.asarray(pos.backlash_mm)[ok] / np.asarray(pos.backlash_rad)[ok]
-                gap = max(gap, 1.5 * p.theta * float(lever.max()))
-            for (k, j), v, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
-                if v and (int(k), int(j)) in p.left_out:
-                    gap = max(gap, float(b))
-        gap = max(models.zone.gap_mm, _on_ladder(gap))
+    gap = models.zone.gap_mm
+    for p, pos in zip(solved, positions, strict=True):
+        ok = np.asarray(pos.pair_valid, dtype=bool) & (np.asarray(pos.backlash_rad) > 0)
+        if ok.any() and p.theta > 0:
+            lever = np.asarray(pos.backlash_mm)[ok] / np.asarray(pos.backlash_rad)[ok]
+            gap = max(gap, 1.5 * p.theta * float(lever.max()))
+        for (k, j), v, b in zip(pos.pairs, pos.pair_valid, pos.backlash_mm, strict=True):
+            if v and (int(k), int(j)) in p.left_out:
+                gap = max(gap, float(b))
+    gap = _on_ladder(gap)  # >= the models' gap already
     zone = cycle_zone(pinion, gear, assembly, opt, gap_mm=gap, exact=True)
     c = zone.n_teeth // 2
     teeth1 = {z.tooth - c for z in zone.pinion}
