@@ -70,6 +70,10 @@ class PairCells:
     origin
         ``(3,)`` fixed frame, the pair's closest point of the TCA on the pinion flank (the grid's
         origin; it rolls along the flank from one position to the next with the contact).
+    edges
+        ``(n, 2, 3)`` mm, fixed frame: the cell's edge vectors along ``ξ`` and ``η`` on the exact
+        flank (``∂r/∂ξ s_ξ``, ``∂r/∂η s_η`` at the cell centre; the half-space near field lays
+        each cell out in its own tangent plane from them).
     """
 
     k: int
@@ -87,6 +91,7 @@ class PairCells:
     boundary: NDArray[np.bool_]
     angle: float = 0.0
     origin: Array | None = None
+    edges: Array | None = None
 
     @property
     def n(self) -> int:
@@ -322,4 +327,5 @@ def pair_cells(
         angle=float(angle),
         boundary=(on_p | on_g)[keep],
         origin=np.asarray(pos.points[ip], dtype=float),
+        edges=np.stack([rx * cu_mm, ry * cv_mm], axis=1),
     )

@@ -37,7 +37,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from fegear.contact import ContactSolution
-from fegear.halfspace import subsurface_influence
+from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
 from fegear.ltca.grid import _separation, pair_cells
 from fegear.ltca.results import LoadedPosition, PairLoad
@@ -204,8 +204,8 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
     if not near.any():
         near = r <= r.min() + 1e-12
     w = np.where(near, 1.0 / near.sum(), 0.0)
-    hw = cells.half_widths
-    S = 2.0 * subsurface_influence(cells.local, 0.0, cells.local, hw, E, nu)
+    lay = tangent_layout(cells.centers, cells.centers, cells.normals, cells.edges)
+    S = 2.0 * layout_influence(lay, 0.0, E, nu)
     c = float(w @ C @ w - w @ S @ w)
     if c < 0.0:
         return 0.0, f"FE stiffer than the half-space at this level (c = {c:.3g} mm/N): clipped to 0"

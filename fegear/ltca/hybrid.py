@@ -11,10 +11,13 @@ inward normal):
 the FE read at depth (where the coarse mesh no longer has to resolve the pressure's near field)
 plus the closed-form compression of the layer ``[0, d]`` of a half-space under uniform pressure
 on rectangular cells (Love 1929 for the surface, the Boussinesq integral below it:
-:func:`fegear.halfspace.subsurface_influence`); the part of the near field the coarse FE
-carries above ``y_i`` is never used, so nothing is counted twice. ``d = min(2h, 0.35 m)`` is tied
-to the element size, so the layer shrinks as the FE is refined and the hybrid tends to the pure
-FE answer (shown on the Hertz scene: ``tests/test_hybrid.py``). The FE part is symmetrised.
+:func:`fegear.halfspace.layout_influence`), each cell laid out in its own tangent plane
+(:func:`fegear.halfspace.tangent_layout`: on a flank whose metric varies, one flat map of a grid
+turned to the patch misplaces the cells; measured 3-20 % on the layer approach); the part of
+the near field the coarse FE carries above ``y_i`` is never used, so nothing is counted twice.
+``d = min(2h, 0.35 m)`` is tied to the element size, so the layer shrinks as the FE is refined
+and the hybrid tends to the pure FE answer (shown on the Hertz scene: ``tests/test_hybrid.py``).
+The FE part is symmetrised.
 Between pairs (different teeth) the plain ``PᵀK⁻¹P`` coupling is used. The operator of each
 member covers the DOFs of the tetrahedra down to ``d`` below its working flanks; a matching point
 outside them moves up (``d`` halved), and a cell overhanging the flank edge reads the FE at the
@@ -32,7 +35,7 @@ import scipy.sparse as sp
 
 from fegear.compliance import cross_compliance, find_tets, probe_operator
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
-from fegear.halfspace import subsurface_influence
+from fegear.halfspace import layout_influence, tangent_layout
 from fegear.ltca.model import cell_load_operators
 
 __all__ = ["hybrid_compliance", "refined_sizes"]
@@ -97,7 +100,8 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
         for op, Q, P in ops:
             Cf = cross_compliance(op, Q[:, sl], P[:, sl])
             S += 0.5 * (Cf + Cf.T)
-        s0 = subsurface_influence(c.local, 0.0, c.local, c.half_widths, models.E, models.nu)
+        lay = tangent_layout(c.centers, c.centers, c.normals, c.edges)
+        s0 = layout_influence(lay, 0.0, models.E, models.nu)
         full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
         for dd in (d1[sl], d2[sl]):
             S += 0.5 * (s0 + s0.T)
@@ -108,14 +112,12 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
                     sd[rows] = s0[rows]
                 elif rows.size > c.n // 4:
                     if float(depth) not in full:
-                        full[float(depth)] = subsurface_influence(
-                            c.local, float(depth), c.local, c.half_widths, models.E, models.nu
+                        full[float(depth)] = layout_influence(
+                            lay, float(depth), models.E, models.nu
                         )
                     sd[rows] = full[float(depth)][rows]
                 else:
-                    sd[rows] = subsurface_influence(
-                        c.local[rows], float(depth), c.local, c.half_widths, models.E, models.nu
-                    )
+                    sd[rows] = layout_influence(lay.rows(rows), float(depth), models.E, models.nu)
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
     return C
