@@ -26,6 +26,7 @@ solver (a Hertz contact on a half-space has a known answer).
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
@@ -241,23 +242,99 @@ def tangent_layout(
     area = np.linalg.norm(np.cross(ed[:, 0], ed[:, 1]), axis=-1)
     hL = 0.5 * length[np.arange(c.shape[0]), long]
     hw = np.stack([area / (4.0 * hL), hL], -1)
-    # d · e = p · e − c · e for each frame vector (matrix products: no (n, m, 3) array)
+    # d · e = p · e − c · e for the three frame vectors: one matrix product, no (n, m, 3) array
     o = c.mean(axis=0)
-    pc, cc = p - o, c - o
-    x = pc @ eS.T - np.sum(cc * eS, -1)[None, :]
-    y = pc @ eL.T - np.sum(cc * eL, -1)[None, :]
-    z = pc @ nrm.T - np.sum(cc * nrm, -1)[None, :]
-    planar2 = x * x + y * y
-    stretch = np.sqrt(
-        np.where(planar2 > 0.0, (planar2 + z * z) / np.where(planar2 > 0, planar2, 1), 1)
-    )
-    return CellLayout(x * stretch, y * stretch, hw)
+    frames = np.concatenate([eS, eL, nrm])  # (3m, 3)
+    xyz = (p - o) @ frames.T
+    xyz -= np.sum((np.concatenate([c, c, c]) - o) * frames, -1)[None, :]
+    m = c.shape[0]
+    x, y, z = xyz[:, :m], xyz[:, m : 2 * m], xyz[:, 2 * m :]
+    # stretch (x, y) to the chord: sqrt(1 + z² / (x² + y²)); the cell itself stays at 0
+    planar2 = x * x
+    planar2 += y * y
+    np.maximum(planar2, _TINY2, out=planar2)
+    np.square(z, out=z)
+    z /= planar2
+    z += 1.0
+    np.sqrt(z, out=z)
+    x *= z
+    y *= z
+    return CellLayout(x, y, hw)
+
+
+#: Far entries (see :func:`layout_influence`): a field point whose distance to the cell (along
+#: the larger of the two axes) is at least ``_FAR_2D`` times the cell's longer half-width takes
+#: 2 x 2 Gauss points; one at least ``_FAR_1D`` half-widths off the cell's ``x`` side, 2 Gauss
+#: points across ``x`` and the exact line integral along ``y``.
+_FAR_2D = 3.0
+_FAR_1D = 3.0
+_GAUSS = 1.0 / math.sqrt(3.0)
+#: mm², below any squared distance between two cell centres.
+_TINY2 = 1e-24
+
+
+def _exact(X1, X2, Y1, Y2, z):
+    """``(∬ 1/ρ, ∬ z/ρ³)`` over the rectangles (corner sums of :func:`_f`, :func:`_f_depth`)."""
+    if z <= 0.0:
+        return rectangle_integral(0.0, 0.0, X1, X2, Y1, Y2), 0.0
+    i1, i2 = 0.0, 0.0
+    for Xa, Ya, sgn in ((X2, Y2, 1.0), (X1, Y2, -1.0), (X2, Y1, -1.0), (X1, Y1, 1.0)):
+        a1, a2 = _f_depth(Xa, Ya, z)
+        i1 = i1 + sgn * a1
+        i2 = i2 + sgn * a2
+    return i1, i2
+
+
+def _gauss_x(x, y, hx, hy, z):
+    """The same by 2 Gauss points across ``x`` and the exact integral along ``y``:
+    ``∫ dY/ρ = asinh(Y/q)``, ``∫ z dY/ρ³ = z Y/(q² ρ)``, ``q² = X² + z²``."""
+    j1, j2 = 0.0, 0.0
+    for g in (-_GAUSS, _GAUSS):
+        X = g * hx - x
+        q2 = X * X + z * z
+        q = np.sqrt(q2)
+        for Y, sgn in ((hy - y, 1.0), (-hy - y, -1.0)):
+            j1 = j1 + sgn * np.arcsinh(Y / q)
+            if z > 0.0:
+                j2 = j2 + sgn * z * Y / (q2 * np.sqrt(q2 + Y * Y))
+    return hx * j1, hx * j2
+
+
+def _gauss_xy(x, y, hx, hy, z):
+    """The same by 2 x 2 Gauss points (point forces)."""
+    X = [np.square(g * hx - x) + z * z for g in (-_GAUSS, _GAUSS)]
+    Y = [np.square(g * hy - y) for g in (-_GAUSS, _GAUSS)]
+    j1 = np.zeros(np.broadcast(x, hx).shape)
+    j2 = np.zeros_like(j1) if z > 0.0 else 0.0
+    for X2 in X:
+        for Y2 in Y:
+            inv = X2 + Y2
+            np.sqrt(inv, out=inv)
+            np.reciprocal(inv, out=inv)
+            j1 += inv
+            if z > 0.0:
+                j2 += inv * inv * inv
+    return hx * hy * j1, z * hx * hy * j2
 
 
 def layout_influence(layout: CellLayout, depth: float, E: float, nu: float) -> np.ndarray:
     """Normal displacement of ONE half-space at depth ``z`` (:func:`subsurface_influence`) at the
     field points of ``layout`` per unit force spread uniformly on each of its cells, ``(n, m)``
-    mm/N."""
+    mm/N:
+
+    .. math:: w = \\frac{z\\,I_3 + 2(1-\\nu) I_1}{4\\pi G A}, \\qquad
+        I_1 = \\iint \\frac{dX\\,dY}{\\rho}, \\quad I_3 = \\iint \\frac{z\\,dX\\,dY}{\\rho^3}.
+
+    Near a cell the integrals are the closed forms (:func:`_f`, :func:`_f_depth`: eight
+    ``asinh`` and four ``atan`` per entry). Away from it the integrand is smooth over the cell
+    and Gauss quadrature is as good at a fraction of the cost: two points across ``x`` and the
+    exact line integral along ``y`` where the field point is ``_FAR_1D`` half-widths off the
+    cell's ``x`` side (the side beside a long thin cell), 2 × 2 points where it is ``_FAR_2D``
+    longer half-widths off the cell. The two-point rule integrates cubics exactly; its error on
+    ``1/ρ`` at a distance ``d`` from a cell of half-width ``h`` is ``~(8/45)(h/d)⁴`` of the
+    entry (Abramowitz & Stegun 25.4.29), below 2e-3 at ``d = 3h`` and measured below 1e-3 on
+    every entry of the gear grids (``tests/test_halfspace.py``).
+    """
     n = layout.x.shape[0]
     if n > _BLOCK and layout.x.size > 20_000:
         # Row blocks on all cores: 2.5x faster on 2 cores for 500 x 500 (bit-identical: the
@@ -265,19 +342,25 @@ def layout_influence(layout: CellLayout, depth: float, E: float, nu: float) -> n
         blocks = [slice(i, min(i + _BLOCK, n)) for i in range(0, n, _BLOCK)]
         parts = _pool().map(lambda b: layout_influence(layout.rows(b), depth, E, nu), blocks)
         return np.vstack(list(parts))
+    z = max(float(depth), 0.0)
     hw = layout.half_widths
-    area = (4.0 * hw[:, 0] * hw[:, 1])[None, :]
-    X1 = -hw[:, 0][None, :] - layout.x
-    X2 = hw[:, 0][None, :] - layout.x
-    Y1 = -hw[:, 1][None, :] - layout.y
-    Y2 = hw[:, 1][None, :] - layout.y
-    if depth <= 0.0:
-        E_one = E / (1.0 - nu * nu)
-        return rectangle_integral(0.0, 0.0, X1, X2, Y1, Y2) / (np.pi * E_one * area)
+    hx, hy = hw[:, 0], hw[:, 1]
+    x, y = layout.x, layout.y
+    # 2 x 2 points everywhere (most entries: no indexing), then the entries near a cell
+    i1, i2 = _gauss_xy(x, y, hx, hy, z)
+    ox, oy = np.abs(x) - hx, np.abs(y) - hy  # distances off the cell's sides
+    rows, cols = np.nonzero(np.maximum(ox, oy) < _FAR_2D * np.maximum(hx, hy))
+    across = ox[rows, cols] >= _FAR_1D * hx[cols]
+    for sel, rule in ((across, _gauss_x), (~across, None)):
+        r, c = rows[sel], cols[sel]
+        xs, ys, hxs, hys = x[r, c], y[r, c], hx[c], hy[c]
+        if rule is None:
+            a1, a2 = _exact(-hxs - xs, hxs - xs, -hys - ys, hys - ys, z)
+        else:
+            a1, a2 = rule(xs, ys, hxs, hys, z)
+        i1[r, c] = a1
+        if z > 0.0:
+            i2[r, c] = a2
     G = E / (2.0 * (1.0 + nu))
-    i1, i2 = 0.0, 0.0
-    for Xa, Ya, sgn in ((X2, Y2, 1.0), (X1, Y2, -1.0), (X2, Y1, -1.0), (X1, Y1, 1.0)):
-        a1, a2 = _f_depth(Xa, Ya, depth)
-        i1 = i1 + sgn * a1
-        i2 = i2 + sgn * a2
-    return (depth * i2 + 2.0 * (1.0 - nu) * i1) / (4.0 * np.pi * G * area)
+    area = (4.0 * hw[:, 0] * hw[:, 1])[None, :]
+    return (z * i2 + 2.0 * (1.0 - nu) * i1) / (4.0 * np.pi * G * area)

@@ -21,7 +21,14 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad
 
-from fegear.halfspace import halfspace_influence, rectangle_integral
+from fegear import halfspace
+from fegear.halfspace import (
+    halfspace_influence,
+    layout_influence,
+    rectangle_integral,
+    subsurface_influence,
+    tangent_layout,
+)
 
 E_STAR = 113186.8131868132  # steel on steel, 206000 / (2 (1 - 0.3²)) MPa
 
@@ -159,3 +166,56 @@ def test_far_field_equals_point_force(ratio: float) -> None:
     # quadrupole 1/(24 ratio²) ≤ 4e-8; the asinh differences lose ~eps (r/w)² off-axis (measured
     # 5e-12 at 1e3, 1e-8 at 1e4): far beyond any contact grid (r/w ≤ ~100), so no tighter claim
     assert C[1, 0] * math.pi * E_STAR * r == pytest.approx(1.0, rel=1e-7)
+
+
+@pytest.mark.parametrize("depth", [0.0, 0.4])
+@pytest.mark.parametrize("aspect", [1.0, 20.0])
+def test_gauss_far_field_matches_the_closed_form_entry_by_entry(
+    monkeypatch: pytest.MonkeyPatch, depth: float, aspect: float
+) -> None:
+    """Away from a cell :func:`layout_influence` integrates by Gauss points instead of the
+    closed form; every entry of a grid of cells (square, and long thin ones as on gear flanks),
+    seen from field points scattered over and around it, stays within 1e-3 of the closed form
+    (the two-point rule's bound at 3 half-widths is (8/45)(1/3)⁴ = 2e-3 of the entry; measured
+    ≤ 5e-4 here and on the gear grids), and the response to a smooth load within 1e-4
+    (measured 4e-5)."""
+    hx, hy = 0.02, 0.02 * aspect
+    i, j = np.meshgrid(np.arange(-12, 13), np.arange(-6, 7), indexing="ij")
+    centres = np.stack([2 * hx * i.ravel(), 2 * hy * j.ravel(), np.zeros(i.size)], -1)
+    m = centres.shape[0]
+    normals = np.tile([0.0, 0.0, 1.0], (m, 1))
+    edges = np.tile(np.array([[2 * hx, 0.0, 0.0], [0.0, 2 * hy, 0.0]]), (m, 1, 1))
+    rng = np.random.default_rng(7)
+    points = np.c_[rng.uniform(-1.5, 1.5, (400, 2)) * [30 * hx, 10 * hy], np.zeros(400)]
+    lay = tangent_layout(points, centres, normals, edges)
+    fast = layout_influence(lay, depth, 206000.0, 0.3)
+    monkeypatch.setattr(halfspace, "_FAR_1D", math.inf)
+    monkeypatch.setattr(halfspace, "_FAR_2D", math.inf)
+    exact = layout_influence(lay, depth, 206000.0, 0.3)
+    assert not np.array_equal(fast, exact)  # the far field took the Gauss points
+    assert np.max(np.abs(fast / exact - 1.0)) < 1e-3
+    load = np.exp(-((centres[:, 0] / (8 * hx)) ** 2) - (centres[:, 1] / (4 * hy)) ** 2)
+    assert np.max(np.abs((fast - exact) @ load)) < 1e-4 * np.max(np.abs(exact @ load))
+
+
+def test_tangent_layout_of_a_flat_grid_is_the_flat_layout() -> None:
+    """On a plane the tangent layout is the plain one: offsets along the cell sides, the long
+    side as ``y`` (here ``x`` is long: the frame turns), half-widths from the edges."""
+    centres = np.array([[0.0, 0.0, 0.0], [0.3, 0.1, 0.0]])
+    normals = np.tile([0.0, 0.0, 1.0], (2, 1))
+    edges = np.tile(np.array([[0.5, 0.0, 0.0], [0.0, 0.1, 0.0]]), (2, 1, 1))
+    lay = tangent_layout(centres, centres, normals, edges)
+    np.testing.assert_allclose(lay.half_widths, [[0.05, 0.25], [0.05, 0.25]])
+    # cell 0 seen from point 1: 0.3 along the long side (x), 0.1 across it (the frame's
+    # e_S = n × e_L = ŷ)
+    assert lay.y[1, 0] == pytest.approx(0.3) and lay.x[1, 0] == pytest.approx(0.1)
+    assert lay.x[0, 0] == 0.0 and lay.y[0, 0] == 0.0
+    flat = subsurface_influence(
+        np.array([[0.0, 0.0], [0.1, 0.3]]),
+        0.2,
+        np.array([[0.0, 0.0], [0.1, 0.3]]),
+        np.array([[0.05, 0.25]] * 2),
+        206000.0,
+        0.3,
+    )
+    np.testing.assert_allclose(layout_influence(lay, 0.2, 206000.0, 0.3), flat, rtol=1e-12)
