@@ -35,7 +35,7 @@ import numpy as np
 from fegear.contact import solve_contact
 from fegear.errors import InputError
 from fegear.ltca.grid import PairCells, pair_cells
-from fegear.ltca.hybrid import hybrid_compliance, refined_sizes
+from fegear.ltca.hybrid import hybrid_compliance, missing_pairs, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
     build_member_model,
@@ -376,10 +376,15 @@ def solve_position(
         log.info("phi1 = %.4f: g_max raised to %.4g mm", pos.phi1, g_max)
     else:
         warnings.append(f"g_max did not settle (last {g_max:.3g} mm)")
+
     # hybrid: refine the cells until every loaded patch has n_across cells across it in both
     # flank directions; the zone shrinks to where the rigid approach theta h can close it.
+    def modelled(k: int, j: int) -> bool:
+        return models.pinion.has_tooth(k) and models.gear.has_tooth(j)
+
     for _ in range(3 if models.fidelity == "hybrid" else 0):
-        sizes = refined_sizes(cells, sol, cell, models.n_across)
+        lost = missing_pairs(pos, cells, g_max, modelled)
+        sizes = refined_sizes(cells, sol, cell, models.n_across, missing=lost)
         if sizes is None:
             break
         h_all = np.concatenate([c.h for c in cells])
@@ -389,6 +394,13 @@ def solve_position(
         if sol2 is None or _excluded_violation(pos, g_ref, sol2.theta):
             break
         cells, sol, g_max, cell = cells2, sol2, g_ref, sizes
+    for k, j in missing_pairs(pos, cells, g_max, modelled):
+        ip = int(np.flatnonzero((pos.pairs[:, 0] == k) & (pos.pairs[:, 1] == j))[0])
+        warnings.append(
+            f"pair ({k}, {j}) at phi1 = {np.degrees(pos.phi1):.3f} deg: its closest point is "
+            f"{1000 * pos.backlash_mm[ip]:.1f} um from contact (edge: {pos.edge[ip] or 'none'}) "
+            "but no contact cell represents it; it carries no load here"
+        )
     # Per-pair results.
     loads, pressures = [], []
     start = 0

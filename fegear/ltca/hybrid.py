@@ -38,7 +38,7 @@ from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.ltca.model import cell_load_operators
 
-__all__ = ["hybrid_compliance", "refined_sizes"]
+__all__ = ["hybrid_compliance", "missing_pairs", "refined_sizes"]
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +127,7 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
 MIN_REFINE_SHARE = 0.01
 
 
-def refined_sizes(cells, sol, cell, n_across, remake=False):
+def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
     """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
     grids are fine enough.
 
@@ -151,6 +151,9 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     carrying less than ``MIN_REFINE_SHARE`` of the torque keeps its grid: it is an edge contact
     starting or ending, whose patch shrinks with every refinement (measured on the seed face
     gear: a pair with 0.3 % of the torque cost two extra solves of ~1050 cells at one position).
+    ``missing``: pairs ``(k, j)`` whose closest point is within the cell bound but which got no
+    cell at all on their grid (a separation valley at a flank edge, narrower than the cells
+    around it: :func:`missing_pairs`); they are treated as idle pairs (below).
     """
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
@@ -195,6 +198,7 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
     # lost). It gets the grid of the pair carrying the most load (not the finest grid: that is
     # usually an edge contact's, and spread over an idle pair's whole zone it made 47 million
     # cells on the face gear at level 1).
+    idle += [(key, cell.get(key, cell[None])) for key in missing if key not in new]
     if idle and heaviest is not None:
         ref = new[heaviest[1]]
         for key, now in idle:
@@ -203,3 +207,15 @@ def refined_sizes(cells, sol, cell, n_across, remake=False):
             else:
                 new[key] = now
     return new if refine else None
+
+
+def missing_pairs(pos, cells, g_max: float, modelled) -> list[tuple[int, int]]:
+    """Pairs ``(k, j)`` of the TCA position whose exact closest point is within ``g_max`` of
+    touching (``pos.backlash_mm``) but which have no cell in ``cells``; ``modelled(k, j)``: the
+    pair's teeth are in the sectors."""
+    have = {(c.k, c.j) for c in cells}
+    out = []
+    for (k, j), ok, b in zip(pos.pairs.tolist(), pos.pair_valid, pos.backlash_mm, strict=True):
+        if ok and 0.0 < b <= g_max and (k, j) not in have and modelled(k, j):
+            out.append((int(k), int(j)))
+    return out
