@@ -114,8 +114,11 @@ class LTCAOptions:
     chunk_positions
         Positions solved in sequence, each from its predecessor (:mod:`fegear.ltca.cycle`); a
         chunk's first position starts from the default cells. Part of the method: the result
-        depends on it (``hybrid``: within the grid-refinement tolerance, measured 0.2 % in TE on
-        the seed face gear), not on ``workers``.
+        depends on it (``hybrid``: within the grid-refinement tolerance; seed face gear, chunks
+        of 7 / 9 / 13: loaded TE p-p 0.4175 / 0.4181 / 0.4177″, chunks of 5: 0.4228″), not on
+        ``workers``. Several chunks per worker balance the load (the positions differ up to 4x
+        in cost); measured warm, 2 workers: face gear 4.6-5.0 s with chunks of 13, 3.8-4.2 s
+        with 7 (9: 4.9-5.7 s, 5: 5.2-5.4 s); spiral bevel 14.9 s with 13, 13.0 s with 7.
     workers
         Processes solving the chunks in parallel; None: one per core (at most one per chunk).
     """
@@ -134,7 +137,7 @@ class LTCAOptions:
     max_cells: int = 600
     depth_elements: float = 2.0
     depth_max_modules: float = 0.35
-    chunk_positions: int = 13
+    chunk_positions: int = 7
     workers: int | None = None
 
     def __post_init__(self) -> None:

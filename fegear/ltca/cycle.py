@@ -8,7 +8,9 @@ in parallel worker processes, forked once the models are built (the compliance o
 memory-mapped, the TCA and the meshes shared copy-on-write: a worker costs ~10 ms to start). The
 chunking is part of the method, the number of workers is not: the result is the same with one
 worker or eight (``tests/test_ltca_cycle.py``). Measured on the seed face gear, ``hybrid`` level
-0, 25 positions, 2 cores: positions 4.5 s in one process, 2.3 s in two (chunks of 13 and 12).
+0, 25 positions, 2 cores: positions 4.5 s in one process, 2.3 s in two (chunks of 13 and 12;
+session 5). Chunks of 7 (four chunks on two workers, taken as workers free up) balance the
+workers better than one chunk each (:class:`~fegear.ltca.analysis.LTCAOptions`).
 
 Where a process cannot fork (no ``fork`` start method, or a daemon process such as a Dask worker),
 the chunks run one after the other in the calling process. ``$FEGEAR_WORKERS`` sets the default
