@@ -34,8 +34,8 @@ import numpy as np
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
-from fegear.ltca.grid import PairCells, pair_cells
-from fegear.ltca.hybrid import hybrid_compliance, missing_pairs, refined_sizes
+from fegear.ltca.grid import PairCells, missing_pairs, pair_cells
+from fegear.ltca.hybrid import hybrid_compliance, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
     build_member_model,

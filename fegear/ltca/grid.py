@@ -28,7 +28,7 @@ from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
 
-__all__ = ["PairCells", "near_cells", "pair_cells"]
+__all__ = ["PairCells", "missing_pairs", "near_cells", "pair_cells"]
 
 Array = NDArray[np.float64]
 _GAUSS2 = np.array([-1.0, 1.0]) / math.sqrt(3.0)
@@ -59,8 +59,10 @@ class PairCells:
     local
         ``(n, 2)`` mm, cell centres in the flank's tangent plane at the pair's closest point
         (along the cell axes ``ξ`` and, in-plane normal to it, ``η``; for the patch measures).
-    half_widths
-        ``(n, 2)`` mm, half the cell sizes along u and v (from the exact flank tangents).
+    edges
+        ``(n, 2, 3)`` mm, fixed frame: the cell's edge vectors along ``ξ`` and ``η`` on the exact
+        flank (``∂r/∂ξ s_ξ``, ``∂r/∂η s_η`` at the cell centre; the half-space near field lays
+        each cell out in its own tangent plane from them).
     cell_mm
         ``(2,)`` mm, cell sizes along the cell axes ``ξ`` and ``η``.
     boundary
@@ -70,10 +72,6 @@ class PairCells:
     origin
         ``(3,)`` fixed frame, the pair's closest point of the TCA on the pinion flank (the grid's
         origin; it rolls along the flank from one position to the next with the contact).
-    edges
-        ``(n, 2, 3)`` mm, fixed frame: the cell's edge vectors along ``ξ`` and ``η`` on the exact
-        flank (``∂r/∂ξ s_ξ``, ``∂r/∂η s_η`` at the cell centre; the half-space near field lays
-        each cell out in its own tangent plane from them).
     """
 
     k: int
@@ -86,12 +84,11 @@ class PairCells:
     h: Array
     area: Array
     local: Array
-    half_widths: Array
+    edges: Array
     cell_mm: Array
     boundary: NDArray[np.bool_]
     angle: float = 0.0
     origin: Array | None = None
-    edges: Array | None = None
 
     @property
     def n(self) -> int:
@@ -297,9 +294,6 @@ def pair_cells(
     area = np.linalg.norm(np.cross(rx, ry), axis=-1) * cu_mm * cv_mm
     edges = np.stack([rx * cu_mm, ry * cv_mm], axis=1)
     local = _patch_coordinates(X[keep], N[keep], edges, np.asarray(pos.points[ip], dtype=float))
-    half_widths = 0.5 * np.stack(
-        [np.linalg.norm(rx, axis=-1) * cu_mm, np.linalg.norm(ry, axis=-1) * cv_mm], -1
-    )
     du, dv = cu_mm, cv_mm  # cell sizes along ξ, η (mm)
     # Cells touching a working-flank boundary of the pinion or the gear.
     tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
@@ -330,10 +324,24 @@ def pair_cells(
         h=h[keep],
         area=area,
         local=local,
-        half_widths=half_widths,
+        edges=edges,
         cell_mm=np.array([du, dv]),
         angle=float(angle),
         boundary=(on_p | on_g)[keep],
         origin=np.asarray(pos.points[ip], dtype=float),
-        edges=edges,
     )
+
+
+def missing_pairs(
+    pos: PositionResult, cells: list[PairCells], g_max: float, modelled
+) -> list[tuple[int, int]]:
+    """Pairs ``(k, j)`` of the TCA position whose exact closest point is within ``g_max`` of
+    touching (``pos.backlash_mm``) but which have no cell in ``cells`` (a separation valley at a
+    flank edge, narrower than the cells around it); ``modelled(k, j)``: the pair's teeth are in
+    the sectors."""
+    have = {(c.k, c.j) for c in cells}
+    out = []
+    for (k, j), ok, b in zip(pos.pairs.tolist(), pos.pair_valid, pos.backlash_mm, strict=True):
+        if ok and 0.0 < b <= g_max and (k, j) not in have and modelled(k, j):
+            out.append((int(k), int(j)))
+    return out

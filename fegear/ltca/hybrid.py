@@ -38,7 +38,7 @@ from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.ltca.model import cell_load_operators
 
-__all__ = ["hybrid_compliance", "missing_pairs", "refined_sizes"]
+__all__ = ["hybrid_compliance", "refined_sizes"]
 
 log = logging.getLogger(__name__)
 
@@ -153,7 +153,7 @@ def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
     gear: a pair with 0.3 % of the torque cost two extra solves of ~1050 cells at one position).
     ``missing``: pairs ``(k, j)`` whose closest point is within the cell bound but which got no
     cell at all on their grid (a separation valley at a flank edge, narrower than the cells
-    around it: :func:`missing_pairs`); they are treated as idle pairs (below).
+    around it: :func:`fegear.ltca.grid.missing_pairs`); they are treated as idle pairs (below).
     """
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
@@ -207,15 +207,3 @@ def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
             else:
                 new[key] = now
     return new if refine else None
-
-
-def missing_pairs(pos, cells, g_max: float, modelled) -> list[tuple[int, int]]:
-    """Pairs ``(k, j)`` of the TCA position whose exact closest point is within ``g_max`` of
-    touching (``pos.backlash_mm``) but which have no cell in ``cells``; ``modelled(k, j)``: the
-    pair's teeth are in the sectors."""
-    have = {(c.k, c.j) for c in cells}
-    out = []
-    for (k, j), ok, b in zip(pos.pairs.tolist(), pos.pair_valid, pos.backlash_mm, strict=True):
-        if ok and 0.0 < b <= g_max and (k, j) not in have and modelled(k, j):
-            out.append((int(k), int(j)))
-    return out
