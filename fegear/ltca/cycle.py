@@ -28,6 +28,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -172,7 +173,8 @@ def run_ltca(
     phi1
         Pinion angles (rad); default ``n_positions`` over one cycle ``[−π/N1, π/N1)``.
     models
-        Pre-built member models (to reuse over several torques).
+        Pre-built member models (to reuse over several torques); the solve options of
+        ``options`` (``n_across``, ``max_cells``, ``trim``) replace those they were built with.
     progress
         Optional callable ``progress(i, n)`` called after each position (in the order they
         finish).
@@ -194,6 +196,8 @@ def run_ltca(
     seconds["tca"] = time.perf_counter() - t0
     if models is None:
         models = build_models(pinion, gear, assembly, opt)
+    else:
+        models = replace(models, n_across=opt.n_across, max_cells=opt.max_cells, trim=opt.trim)
     seconds["models"] = models.seconds
     t0 = time.perf_counter()
     parts = chunks(len(tca_pos), opt.chunk_positions)

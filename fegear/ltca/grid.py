@@ -17,7 +17,7 @@ in a local flank-plane coordinate system (mm) for the patch measures.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,7 +28,7 @@ from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
 
-__all__ = ["PairCells", "missing_pairs", "near_cells", "pair_cells"]
+__all__ = ["PairCells", "missing_pairs", "near_cells", "pair_cells", "take_cells"]
 
 Array = NDArray[np.float64]
 _GAUSS2 = np.array([-1.0, 1.0]) / math.sqrt(3.0)
@@ -329,6 +329,26 @@ def pair_cells(
         angle=float(angle),
         boundary=(on_p | on_g)[keep],
         origin=np.asarray(pos.points[ip], dtype=float),
+    )
+
+
+def take_cells(cells: PairCells, index: NDArray[np.intp]) -> PairCells:
+    """The cells ``index`` of one pair's cells (same grid; ``local`` re-centred on them)."""
+    local = cells.local[index]
+    if local.shape[0]:
+        local = local - local.mean(axis=0)
+    return replace(
+        cells,
+        uv=cells.uv[index],
+        centers=cells.centers[index],
+        normals=cells.normals[index],
+        quad_points=cells.quad_points[index],
+        gap=cells.gap[index],
+        h=cells.h[index],
+        area=cells.area[index],
+        local=local,
+        edges=cells.edges[index],
+        boundary=cells.boundary[index],
     )
 
 

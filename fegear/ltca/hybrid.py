@@ -38,7 +38,7 @@ from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.ltca.model import cell_load_operators
 
-__all__ = ["hybrid_compliance", "refined_sizes"]
+__all__ = ["hybrid_compliance", "hybrid_displacement", "refined_sizes"]
 
 log = logging.getLogger(__name__)
 
@@ -72,17 +72,18 @@ def _probe(model, M, x, inward, P, depth: float) -> tuple[sp.csc_matrix, np.ndar
     return sp.csc_matrix(Q), d
 
 
-def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
+def hybrid_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
     """Hybrid compliance: inside each pair, FE at the matching depth + the half-space compression
     of the layer ``[0, d]`` of each member (cells in intrinsic flank coordinates); between pairs
-    (different teeth, far apart) the plain surface coupling ``PᵀK⁻¹P``."""
+    (different teeth, far apart) the plain surface coupling ``PᵀK⁻¹P``. ``loads``: the cells'
+    :func:`~fegear.ltca.model.cell_load_operators` if already made."""
     asm = tca.asm
     M1 = asm.placement1(pos.phi1)
     M2 = asm.placement2(pos.phi2)
     n1 = np.concatenate([c.normals for c in cells])
     x1 = np.concatenate([c.centers for c in cells])
     x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in cells])
-    P1, P2 = cell_load_operators(models, M1, M2, cells)
+    P1, P2 = loads if loads is not None else cell_load_operators(models, M1, M2, cells)
     P1, P2 = P1.tocsc(), P2.tocsc()
     Q1, d1 = _probe(models.pinion, M1, x1, -n1, P1, models.depth_mm)
     Q2, d2 = _probe(models.gear, M2, x2, n1, P2, models.depth_mm)
@@ -121,6 +122,72 @@ def hybrid_compliance(tca, pos, models, cells) -> np.ndarray:
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
     return C
+
+
+def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.ndarray:
+    """Approach ``(C F)_i`` (mm, both members) of the cells ``readers`` under the forces
+    ``forces`` (N, ``(Σ n,)``) on the cells ``loaded`` (their load operators ``loads``, as
+    :func:`~fegear.ltca.model.cell_load_operators` returns them), with the compliance of
+    :func:`hybrid_compliance` read without its symmetrisation: inside a pair the FE at the
+    matching depth below each reader plus the layer compression, between pairs ``PᵀK⁻¹P``.
+    ``loaded[p]`` and ``readers[p]`` are cells of the same pair ``p`` (``readers[p]`` may be
+    empty).
+
+    The cost is that of the loaded × reader entries only (no square compliance; one read of
+    each member's operator): it checks a solution on the cells it left out
+    (:func:`fegear.ltca.analysis.solve_position`).
+    """
+    asm = tca.asm
+    M1 = asm.placement1(pos.phi1)
+    M2 = asm.placement2(pos.phi2)
+    have = [c for c in readers if c.n]
+    R1, R2 = cell_load_operators(models, M1, M2, have)
+    n1 = np.concatenate([c.normals for c in have])
+    x1 = np.concatenate([c.centers for c in have])
+    x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in have])
+    Q1, d1 = _probe(models.pinion, M1, x1, -n1, R1.tocsc(), models.depth_mm)
+    Q2, d2 = _probe(models.gear, M2, x2, n1, R2.tocsc(), models.depth_mm)
+    ends_l = np.cumsum([0] + [c.n for c in loaded])
+    ends_r = np.cumsum([0] + [c.n for c in readers])
+    F = np.asarray(forces, dtype=float)
+    # Per pair p: the load of its own cells (read at depth) and that of the other pairs (read at
+    # the surface): one column each, all read in one product per member.
+    own = np.zeros((F.size, len(loaded)))
+    for p in range(len(loaded)):
+        own[ends_l[p] : ends_l[p + 1], p] = F[ends_l[p] : ends_l[p + 1]]
+    other = F[:, None] - own
+    u = np.zeros(int(ends_r[-1]))
+    for op, Q, R, P in ((models.pinion.op, Q1, R1, loads[0]), (models.gear.op, Q2, R2, loads[1])):
+        cols = sp.csc_matrix(P @ np.hstack([own, other]))
+        W = cross_compliance(op, sp.hstack([Q, R]).tocsc(), cols)  # (2 n_read, 2 n_pairs)
+        nr = Q.shape[1]
+        at = 0
+        for p, c in enumerate(readers):
+            if c.n == 0:
+                continue
+            rows = np.arange(ends_r[p], ends_r[p + 1])
+            u[rows] += W[at : at + c.n, p] + W[nr + at : nr + at + c.n, len(loaded) + p]
+            at += c.n
+    # The layer compression of each member from the pair's own loaded cells.
+    at = 0
+    for p, (cl, cr) in enumerate(zip(loaded, readers, strict=True)):
+        if cr.n == 0:
+            continue
+        rows, sub = np.arange(ends_r[p], ends_r[p + 1]), slice(at, at + cr.n)
+        at += cr.n
+        if cl.n == 0:
+            continue
+        fl = F[ends_l[p] : ends_l[p + 1]]
+        lay = tangent_layout(cr.centers, cl.centers, cl.normals, cl.edges)
+        s0 = layout_influence(lay, 0.0, models.E, models.nu) @ fl
+        for dd in (d1[sub], d2[sub]):
+            for depth in np.unique(dd):
+                if depth == 0.0:
+                    continue  # read at the surface: no layer
+                k = np.flatnonzero(dd == depth)
+                sd = layout_influence(lay.rows(k), float(depth), models.E, models.nu) @ fl
+                u[rows[k]] += s0[k] - sd
+    return u
 
 
 #: A pair carrying less than this share of the torque does not drive the refinement.
