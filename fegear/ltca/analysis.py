@@ -20,6 +20,16 @@ At each mesh position (DESIGN §8):
 
 The loaded TE is the unloaded TE minus the lag ``θ`` (arcsec).
 
+``hybrid`` solves most positions from their predecessor's solution, and uses it once more: the
+cells whose loaded gap, predicted from that solution's approach field ``g − d``, exceeds
+``trim θ h_max`` are left out of the solve (:func:`fegear.ltca.warm.likely_cells`). The contact
+problem restricted to cells that hold its active set has the same solution, so the trimmed
+solve is accepted only if the ring of left-out cells around the kept ones stays open under it
+(their loaded gap computed from the active cells' forces, :func:`_trim_holds`); otherwise the
+position is solved on all cells. Measured on the seed face gear (hybrid level 0, 25 positions,
+``trim = 0.3``): 57 % of the cells kept, no trimmed solve rejected, loaded TE equal to 1e-11″,
+positions 7.0 → 5.0 s in one process.
+
 The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair: see
 :mod:`fegear.ltca.hybrid`. :func:`fegear.ltca.cycle.run_ltca` runs the positions of a cycle.
 """
