@@ -22,7 +22,10 @@ Between pairs (different teeth) the plain ``PᵀK⁻¹P`` coupling is used. The 
 member covers the DOFs of the tetrahedra down to ``d`` below its working flanks; a matching point
 outside them moves up (``d`` halved), and a cell overhanging the flank edge reads the FE at the
 surface. The cells of each pair are refined on a grid turned to its patch's axes
-(:func:`_refined_sizes`), starting from the previous position's grid.
+(:func:`refined_sizes`), starting from the previous position's grid; the cells predicted far
+from contact are left out of a solve, and :func:`hybrid_displacement` (the same compliance,
+loaded cells × reading cells only) checks that they stay open
+(:mod:`fegear.ltca.analysis`).
 """
 
 from __future__ import annotations
