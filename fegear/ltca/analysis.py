@@ -28,7 +28,7 @@ solve is accepted only if the ring of left-out cells around the kept ones stays 
 (their loaded gap computed from the active cells' forces, :func:`_trim_holds`); otherwise the
 position is solved on all cells. Measured on the seed face gear (hybrid level 0, 25 positions,
 ``trim = 0.3``): 57 % of the cells kept, no trimmed solve rejected, loaded TE equal to 1e-11″,
-positions 7.0 → 5.0 s in one process.
+warm positions 6.1–7.3 → 4.1–4.7 s in one process (alternating runs).
 
 The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair: see
 :mod:`fegear.ltca.hybrid`. :func:`fegear.ltca.cycle.run_ltca` runs the positions of a cycle.
