@@ -200,6 +200,10 @@ def run_ltca(
         models = replace(models, n_across=opt.n_across, max_cells=opt.max_cells, trim=opt.trim)
     seconds["models"] = models.seconds
     t0 = time.perf_counter()
+    # The exact flank evaluators are built on first use (spiral bevel: 0.8 s per flank): once
+    # here, not in every forked worker.
+    tca.fm1.native_box()
+    tca.fm2.native_box()
     parts = chunks(len(tca_pos), opt.chunk_positions)
     workers = _workers(opt.workers, len(parts))
     job = {

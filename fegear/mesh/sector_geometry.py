@@ -240,12 +240,13 @@ def sector_frame(member: GeneratedMember, rim_modules: float = 3.0) -> SectorFra
         root = Line(-ded + A0 * td, -td)
         tip = Line(bl.addenda[i - 1] - A0 * tj, tj)
         bot = Line(root.a - rim_modules * m, root.b)
-        # plus side: the side whose mean point has the larger polar angle
+        # plus side: the side whose mean point has the larger polar angle (one exact envelope
+        # point per side, 15 ms; building a side's native evaluator for it took 0.8 s, for the
+        # unloaded side on every warm run)
         um, vm = member.mean_parameters()
         ang = {}
         for s in ("drive", "coast"):
-            nf = member.native_flank(s)
-            p = nf.evaluate(*nf.native(np.array([um]), np.array([vm])))[0][0]
+            p = member.point_normal(s, np.array([um]), np.array([vm]))[0][0]
             ang[s] = math.atan2(p[1], p[0])
         plus: Side = "drive" if ang["drive"] > ang["coast"] else "coast"
         bd = member.boundaries()
