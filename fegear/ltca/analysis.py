@@ -110,9 +110,20 @@ class LTCAOptions:
         the closed-form half-space compression of the layer above it (Vijayakar 1991; the split
         validated on the Hertz scene, :func:`fegear.scenes.hertz_scene.hybrid_compliance`),
         inside each pair; plain ``PᵀK⁻¹P`` between pairs. The cells are refined below the
-        element size until ``n_across`` of them span each loaded patch.
+        element size until ``n_across`` of them span each loaded patch across and ``n_along``
+        along it.
     n_across
-        ``hybrid``: cells wanted across each loaded patch in both flank directions.
+        ``hybrid``: cells wanted across each loaded patch (its minor axis).
+    n_along
+        ``hybrid``: cells wanted along each loaded patch (its major axis; never coarser than
+        the element size). The loaded TE converges in the cell length along the patch:
+        measured at level 0 against grids of 0.14-0.35 mm cells along (the TE within 0.002″):
+        seed face gear, φ1 = 4.32° (one pair, 35 mm long patch), n_along 8 / 16 / 32: TE
+        −4.0996 / −4.1056 / −4.1064″; cycle TE rms error 0.0079 / 0.0064″ (8 / 16), TE
+        peak-to-peak −4.9 / −0.9 %; spiral bevel, positions 0 / 8 / 16: errors 0.12-0.14″ (8)
+        → 0.05-0.08″ (16) of 73-84″, interior p_peak +1.1-2.6 % → +0.9-1.2 %, shares within
+        0.001 either way. Cost (warm cycle, 2 workers): face gear 1.9 → 2.2 s, bevel
+        5.1 → 7.5 s.
     max_cells
         ``hybrid``: cells per pair at most (both sizes grow in proportion beyond): caps the
         cost of the dense compliance (n²) where a pair's patch is tiny, i.e. at an edge
@@ -155,6 +166,7 @@ class LTCAOptions:
     backend: str = "auto"
     fidelity: str = "fe"
     n_across: int = 8
+    n_along: int = 16
     max_cells: int = 600
     depth_elements: float = 2.0
     depth_max_modules: float = 0.35
@@ -169,6 +181,10 @@ class LTCAOptions:
             raise InputError("chunk_positions", self.chunk_positions, "an integer >= 1")
         if self.workers is not None and not (isinstance(self.workers, int) and self.workers >= 1):
             raise InputError("workers", self.workers, "an integer >= 1, or None for all cores")
+        for name in ("n_across", "n_along", "max_cells"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and value >= 1):
+                raise InputError(name, value, "an integer >= 1")
         if not (np.isfinite(self.trim) and self.trim >= 0.0):
             raise InputError("trim", self.trim, "a finite number >= 0 (0: keep every cell)")
         if self.n_teeth is not None and not (isinstance(self.n_teeth, int) and self.n_teeth >= 1):
@@ -188,6 +204,7 @@ class MemberModels:
     E: float = 206000.0
     nu: float = 0.3
     n_across: int = 8
+    n_along: int = 16
     max_cells: int = 600
     zone: ContactZone | None = None
     trim: float = 0.3
@@ -269,6 +286,7 @@ def build_models(
         E=options.E_MPa,
         nu=options.nu,
         n_across=options.n_across,
+        n_along=options.n_along,
         max_cells=options.max_cells,
         zone=zone,
         trim=options.trim,
@@ -428,7 +446,9 @@ def solve_position(
         # Grids made for the previous position's measured patches (not merely accepted for
         # them): a grid drifting with a growing or shrinking patch would cross the acceptance
         # bounds and cost a second solve (measured on the seed face gear: 39 -> 34 solves).
-        made = refined_sizes(previous.cells, previous.solution, cell, models.n_across, True)
+        made = refined_sizes(
+            previous.cells, previous.solution, cell, models.n_across, True, n_along=models.n_along
+        )
         cell = made if made is not None else cell
     fps = None
     if previous is not None and previous.cells:
@@ -461,7 +481,9 @@ def solve_position(
 
     for _ in range(3 if models.fidelity == "hybrid" else 0):
         lost = missing_pairs(pos, cells, g_max, modelled)
-        sizes = refined_sizes(cells, sol, cell, models.n_across, missing=lost)
+        sizes = refined_sizes(
+            cells, sol, cell, models.n_across, missing=lost, n_along=models.n_along
+        )
         if sizes is None:
             break
         g_ref = max(1.5 * sol.theta * h_max, 1e-6)

@@ -197,7 +197,13 @@ def run_ltca(
     if models is None:
         models = build_models(pinion, gear, assembly, opt)
     else:
-        models = replace(models, n_across=opt.n_across, max_cells=opt.max_cells, trim=opt.trim)
+        models = replace(
+            models,
+            n_across=opt.n_across,
+            n_along=opt.n_along,
+            max_cells=opt.max_cells,
+            trim=opt.trim,
+        )
     seconds["models"] = models.seconds
     t0 = time.perf_counter()
     # The exact flank evaluators are built on first use (spiral bevel: 0.8 s per flank): once

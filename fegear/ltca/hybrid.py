@@ -207,7 +207,7 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
 MIN_REFINE_SHARE = 0.01
 
 
-def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
+def refined_sizes(cells, sol, cell, n_across, remake=False, missing=(), n_along=None):
     """Per-pair cell grids ``(s_ξ, s_η, angle)`` for the ``hybrid`` refinement, or None if the
     grids are fine enough.
 
@@ -217,12 +217,13 @@ def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
     (the Hertz pressure ``p0 sqrt(1 - x²/a² - y²/b²)`` has ``∫x² p / ∫p = a²/5``; a cell
     spreads its force over its span). A cell of sizes
     ``s = (s_ξ, s_η)`` spans ``|m|·s`` across the patch and ``|M|·s`` along it; the pair is
-    accepted when ``2b`` holds ``0.75 n_across`` such spans and ``2a`` as many, otherwise its
-    next grid is turned to the patch axes (``η`` along ``M``: the thin, long patches of gears are
-    oblique to the flank grid, and an unaligned grid fine enough across them has ``(a/b)²``
-    times more cells) with ``s = (2b, 2a) / (1.25 n_across)``, never coarser than the element-size
-    cells. A grid whose cells are less than 0.4 times the area of those (too fine, or turned
-    away from the patch: a pair's grid starts from the previous position's, where its patch may
+    accepted when ``2b`` holds ``0.75 n_across`` such spans and ``2a`` holds ``0.75 n_along``
+    (default ``n_across``), otherwise its next grid is turned to the patch axes (``η`` along
+    ``M``: the thin, long patches of gears are oblique to the flank grid, and an unaligned grid
+    fine enough across them has ``(a/b)²`` times more cells) with
+    ``s = (2b / n_across, 2a / n_along) / 1.25``, never coarser than the element-size cells. A
+    grid whose cells are less than 0.4 times the area of those (too fine, or turned away from
+    the patch: a pair's grid starts from the previous position's, where its patch may
     have been much smaller) is re-made the same way. Aiming above the target lets the next grid
     pass, as a coarse grid over-estimates the patch. Each pair gets its own grid: a small patch
     (an edge contact carrying little load) does not refine its neighbour. ``remake``: every
@@ -235,6 +236,7 @@ def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
     cell at all on their grid (a separation valley at a flank edge, narrower than the cells
     around it: :func:`fegear.ltca.grid.missing_pairs`); they are treated as idle pairs (below).
     """
+    n_along = n_across if n_along is None else n_along
     start, new, refine = 0, {None: cell[None]}, False
     base = cell[None][0]
     idle, heaviest = [], None
@@ -262,8 +264,8 @@ def refined_sizes(cells, sol, cell, n_across, remake=False, missing=()):
         # measures at least that width.
         b2 = 2.0 * np.sqrt(5.0 * (max(lam[0], 0.0) + span_b**2 / 12.0))
         a2 = 2.0 * np.sqrt(5.0 * (max(lam[1], 0.0) + span_a**2 / 12.0))
-        ideal = (min(base, b2 / (1.25 * n_across)), min(base, a2 / (1.25 * n_across)))
-        fine = b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_across * span_a
+        ideal = (min(base, b2 / (1.25 * n_across)), min(base, a2 / (1.25 * n_along)))
+        fine = b2 >= 0.75 * n_across * span_b and a2 >= 0.75 * n_along * span_a
         wasteful = size[0] * size[1] < 0.4 * ideal[0] * ideal[1]
         if fine and not wasteful and not remake:
             new[key] = now
