@@ -258,3 +258,66 @@ def test_the_dgamma_face_gear_sector_meshes_with_hxt_first_time():
     d = sm.diagnostics  # how the mesh was made (kept beside it in the cache)
     assert d["attempts"] == 1 and d["algorithm3d"] == 10  # HXT, first time
     assert d["min_sicn"] >= 0.03  # the quality every sector must have
+
+
+def test_a_flat_surface_triangle_puts_one_segment_on_the_short_top_land_edges(monkeypatch):
+    """The repair of :func:`fegear.mesh.sector._fix_flat_triangles`, on a block whose 0.8 mm wide
+    top meets its end face (the face gear's outer top land): gmsh puts two segments on that edge
+    (``Mesh.MinimumCurveNodes`` = 3). Whether the surface mesher then closes a triangle on those
+    three collinear nodes depends on the host, so the flat triangle is reported by a stub of the
+    quality query; the repair must give the short top ∩ end edges (and only those) one segment
+    and re-mesh the surfaces."""
+    import gmsh
+
+    from fegear.mesh import sector
+    from fegear.mesh.gmsh_session import initialize
+
+    initialize()
+    try:
+        gmsh.model.add("block")
+        gmsh.model.occ.addBox(0, 0, 0, 10, 0.8, 5)
+        gmsh.model.occ.synchronize()
+        faces = {
+            name: [
+                t
+                for _, t in gmsh.model.getEntitiesInBoundingBox(*box, dim=2)
+                if gmsh.model.occ.getMass(2, t) > 0
+            ]
+            for name, box in {
+                "top_0": (-1, -1, 4.9, 11, 2, 5.1),
+                "face_end": (9.9, -1, -1, 10.1, 2, 6),
+                "face_start": (-0.1, -1, -1, 0.1, 2, 6),
+            }.items()
+        }
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 2.0)
+        # Two segments on every edge, as on the sector's curved edges (MinimumCurveNodes = 3).
+        gmsh.option.setNumber("Mesh.MinimumLineNodes", 3)
+        gmsh.model.mesh.generate(2)
+        for _, c in gmsh.model.getEntities(1):
+            assert len(gmsh.model.mesh.getNodes(1, c, includeBoundary=True)[0]) >= 3
+        assert sector._fix_flat_triangles(gmsh, faces, 2.0) == 0  # a good mesh is left alone
+        qualities = gmsh.model.mesh.getElementQualities
+
+        def one_flat(tags, name):
+            q = np.array(qualities(tags, name))
+            q[0] = 0.0
+            return q
+
+        monkeypatch.setattr(gmsh.model.mesh, "getElementQualities", one_flat)
+        assert sector._fix_flat_triangles(gmsh, faces, 2.0) == 1
+        monkeypatch.undo()
+        top = {c for _, c in gmsh.model.getBoundary([(2, t) for t in faces["top_0"]], False, False)}
+        ends = {
+            c
+            for name in ("face_end", "face_start")
+            for _, c in gmsh.model.getBoundary([(2, t) for t in faces[name]], False, False)
+        }
+        for c in {c for _, c in gmsh.model.getEntities(1)}:
+            nodes, _, _ = gmsh.model.mesh.getNodes(1, c, includeBoundary=True)
+            short_edge = c in top & ends  # the top's 0.8 mm edges; not the bottom's, 10 or 5 mm
+            assert (len(nodes) == 2) == short_edge, (c, len(nodes), gmsh.model.occ.getMass(1, c))
+        tags, _ = gmsh.model.mesh.getElementsByType(2)
+        assert len(tags) > 0  # the surfaces are meshed again
+    finally:
+        gmsh.finalize()
