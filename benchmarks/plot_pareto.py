@@ -40,6 +40,7 @@ def _series(ax, rows, key_err, key_t="cold_s", label_fn=None):
                         xytext=(3, 3), textcoords="offset points")  # fmt: skip
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # the labels overlapped
     ax.grid(True, which="both", lw=0.3)
 
 
