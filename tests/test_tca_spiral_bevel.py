@@ -65,6 +65,10 @@ def test_native_flank_is_the_engine_surface(pair):
             fs = (fm.evaluate(s + h, th)[0] - fm.evaluate(s - h, th)[0]) / (2 * h)
             ft = (fm.evaluate(s, th + h)[0] - fm.evaluate(s, th - h)[0]) / (2 * h)
             assert np.abs(rs - fs).max() < 1e-6 and np.abs(rt - ft).max() < 1e-6
+            # native_point hands over the inversion's last evaluation: the same numbers, exactly
+            s2, th2, p2, n2 = fm.native_point(u, v)
+            for x, y in ((s2, s), (th2, th), (p2, p), (n2, n)):
+                assert x.shape == y.shape and np.array_equal(x, y), (m.name, side)
 
 
 def test_te_parabola_with_designed_amplitude_and_transfer_points(pair, nominal):

@@ -709,6 +709,11 @@ class NativeFlank:
 
     def native(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11) -> tuple[Array, Array]:
         """``(s, θ)`` of flank coordinates (2-D Newton on ``(L, h)``, analytic tangents)."""
+        return self.native_evaluation(u, v, tol)[:2]
+
+    def native_evaluation(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11):
+        """:meth:`native` and :meth:`evaluate` (with tangents) at the result: ``(s, θ, p, n,
+        r_s, r_θ)``; the Newton's last evaluation, at the converged ``(s, θ)``."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         m = self.member
         L_t, h_t = v, m.height(u, v)
@@ -717,7 +722,7 @@ class NativeFlank:
         g = m.pitch_angle
         err = np.inf
         for _ in range(30):
-            p, _, rs, rt = self.evaluate(s, th, tangents=True)
+            p, n, rs, rt = self.evaluate(s, th, tangents=True)
             L, h, gL, gh = _cone_coords(p, g)
             F1, F2 = L - L_t, h - h_t
             err = float(np.max(np.abs(np.stack([F1, F2])))) if F1.size else 0.0
@@ -735,4 +740,4 @@ class NativeFlank:
             )
         if not np.isfinite(err):
             raise SolverError(f"spiral bevel {m.name} {self.side}: (u, v) -> (s, theta) NaN")
-        return s, th
+        return s, th, p, n, rs, rt

@@ -99,8 +99,7 @@ def _separation(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
     """Separations of pinion-flank points ``(U, V)`` of pair ``i`` (as ``TCA._grids``)."""
     a = tca.asm
     fm1, fm2 = tca.fm1, tca.fm2
-    ca, cb = fm1.native(U, V)
-    P, N = fm1.evaluate(ca, cb)
+    _, _, P, N = fm1.native_point(U, V)
     T = tca._tooth_frames(np.array([phi1]), np.array([ts]))[0][i]
     Q, NQ = apply_points(T, P), apply_vectors(T, N)
     idx = tca.gtree.query(np.stack([np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2]], -1))[1]
@@ -283,8 +282,7 @@ def pair_cells(
     gx, gy = np.broadcast_arrays(gx, gy)
     gu = uc + A[0, 0] * gx + A[0, 1] * gy
     gv = vc + A[1, 0] * gx + A[1, 1] * gy
-    qa, qb = tca.fm1.native(gu.reshape(-1), gv.reshape(-1))
-    Pq, _ = tca.fm1.evaluate(qa, qb)
+    _, _, Pq, _ = tca.fm1.native_point(gu.reshape(-1), gv.reshape(-1))
     Mk = compose(tca.asm.placement1(pos.phi1), tooth_transform(tca.asm.n1, g.k))
     quad = apply_points(Mk, Pq).reshape(-1, 4, 3)
     # Areas from the Gauss points: |r_ξ x r_η| dξ dη by central differences of the 2x2 points.

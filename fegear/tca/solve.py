@@ -135,12 +135,14 @@ def line_hit(
     lo, hi = fm.native_box()
     span = hi - lo
     lo, hi = lo - 0.5 * span, hi + 0.5 * span
+    converged = False
     for _ in range(max_iter):
-        p, _ = fm.evaluate(a, b)
-        ra, rb = fm.jacobian(a, b, p)
+        p, n = fm.evaluate(a, b)
         F = p - P - s[..., None] * N
         if np.all(np.linalg.norm(F, axis=-1) < TOL_MM):
+            converged = True  # p, n are those of the final (a, b): no evaluation again
             break
+        ra, rb = fm.jacobian(a, b, p)
         J = np.stack([ra, rb, -N], -1)
         # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
         dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[..., None])[..., 0]
@@ -154,7 +156,8 @@ def line_hit(
         a = np.clip(a + dx[..., 0] / sc, lo[0], hi[0])
         b = np.clip(b + dx[..., 1] / sc, lo[1], hi[1])
         s = s + dx[..., 2] / sc
-    p, n = fm.evaluate(a, b)
+    if not converged:
+        p, n = fm.evaluate(a, b)
     res = np.linalg.norm(p - P - s[..., None] * N, axis=-1)
     ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
     return a, b, s, p, n, ok

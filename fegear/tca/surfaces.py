@@ -76,6 +76,13 @@ class FlankMap:
         """Exact points ``(..., 3)`` and outward unit normals in the member frame."""
         return self.member.point_normal(self.side, a, b)
 
+    def native_point(self, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array, Array, Array]:
+        """``(a, b, p, n)``: :meth:`native` and :meth:`evaluate` at once (a map whose inversion
+        evaluates the flank anyway hands its last evaluation over)."""
+        a, b = self.native(u, v)
+        p, n = self.evaluate(a, b)
+        return a, b, p, n
+
     def flank(self, a: Array, b: Array, p: Array) -> tuple[Array, Array]:
         """Flank coordinates ``(u, v)`` of native parameters (``p`` their points)."""
         return np.asarray(a, float), np.asarray(b, float)
@@ -236,6 +243,13 @@ class SpiralBevelMap(FlankMap):
 
     def native(self, u, v):
         return self._nf().native(u, v)
+
+    def native_point(self, u, v):
+        # the (u, v) -> (s, θ) Newton ends on an evaluation at the converged (s, θ): 1 of the
+        # ~4 evaluations of a grid point saved
+        s, th, p, n, rs, rt = self._nf().native_evaluation(u, v)
+        self._cache["last"] = (p, rs, rt)
+        return s, th, p, n
 
     def _native_box(self):
         lo, hi = self._nf().box
