@@ -157,26 +157,26 @@ def test_separation_grid_is_a_contact_grid(conjugate):
 
 
 def test_line_hit_from_the_interpolated_start_finds_the_same_flank_points():
-    """``TCA.gear_start`` interpolates the gear's 21 × 21 flank samples over ``(ρ, z)``: it
-    returns the samples themselves at their own points and the nearest sample outside them;
-    ``line_hit`` from it (each line iterating only until it has converged) meets the gear
-    flank where it does from the nearest sample."""
+    """``TCA.gear_start`` (the start of every Newton solve on the gear flank) interpolates the
+    gear's 21 × 21 flank samples over ``(ρ, z)``: it returns the samples themselves at their own
+    points and the nearest sample outside them; ``line_hit`` from it (each line iterating only
+    until it has converged) meets the gear flank where it does from the nearest sample."""
     from fegear.tca.solve import TOL_MM, line_hit
 
     asm = involute_assembly(PINION, GEAR)
     tca = TCA(PINION, GEAR, asm, TCAOptions())
-    a, b = tca.gear_start(tca.fm2.evaluate(tca.ga, tca.gb)[0])
+    g = tca.fm2.evaluate(tca.ga, tca.gb)[0]
+    a, b = tca.gear_start(np.hypot(g[:, 0], g[:, 1]), g[:, 2])
     np.testing.assert_allclose(a, tca.ga, rtol=0, atol=1e-9)  # the nodes, to round-off
     np.testing.assert_allclose(b, tca.gb, rtol=0, atol=1e-9)
-    far = np.array([[1e4, 0.0, 1e4]])  # outside the samples: the nearest one
-    idx = tca.gtree.query([[np.hypot(1e4, 0.0), 1e4]])[1]
-    assert tca.gear_start(far)[0] == pytest.approx(tca.ga[idx])
+    idx = tca.gtree.query([[1e4, 1e4]])[1]  # outside the samples: the nearest one
+    assert tca.gear_start(np.array([1e4]), np.array([1e4]))[0] == pytest.approx(tca.ga[idx])
     # lines through points 0.01 mm off the gear flank, along its normal
     rng = np.random.default_rng(1)
     k = rng.choice(tca.ga.size, 40, replace=False)
     p0, n0 = tca.fm2.evaluate(tca.ga[k] + 1e-3, tca.gb[k] + 1e-3)
     Q, N = p0 + 0.01 * n0, -n0
-    hit = line_hit(tca.fm2, *tca.gear_start(Q), Q, N)
+    hit = line_hit(tca.fm2, *tca.gear_start(np.hypot(Q[:, 0], Q[:, 1]), Q[:, 2]), Q, N)
     idx = tca.gtree.query(np.stack([np.hypot(Q[:, 0], Q[:, 1]), Q[:, 2]], -1))[1]
     ref = line_hit(tca.fm2, tca.ga[idx], tca.gb[idx], Q, N)
     assert hit[5].all() and ref[5].all()

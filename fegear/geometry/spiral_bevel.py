@@ -712,8 +712,8 @@ class NativeFlank:
         return self.native_evaluation(u, v, tol)[:2]
 
     def native_evaluation(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11):
-        """:meth:`native` and :meth:`evaluate` (with tangents) at the result: ``(s, θ, p, n,
-        r_s, r_θ)``; the Newton's last evaluation, at the converged ``(s, θ)``."""
+        """:meth:`native` and :meth:`evaluate` at the result: ``(s, θ, p, n)``, the Newton's
+        last evaluation, at the converged ``(s, θ)``."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         m = self.member
         L_t, h_t = v, m.height(u, v)
@@ -740,4 +740,4 @@ class NativeFlank:
             )
         if not np.isfinite(err):
             raise SolverError(f"spiral bevel {m.name} {self.side}: (u, v) -> (s, theta) NaN")
-        return s, th, p, n, rs, rt
+        return s, th, p, n

@@ -102,7 +102,7 @@ def _separation(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
     _, _, P, N = fm1.native_point(U, V)
     T = tca._tooth_frames(np.array([phi1]), np.array([ts]))[0][i]
     Q, NQ = apply_points(T, P), apply_vectors(T, N)
-    a0, b0 = tca.gear_start(Q)
+    a0, b0 = tca.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
     a2, b2, s, p2, n2, ok = line_hit(fm2, a0, b0, Q, NQ)
     u2, v2 = fm2.flank(a2, b2, p2)
     ok = ok & in_bounds(fm2, u2, v2)

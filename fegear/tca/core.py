@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicSpline, LinearNDInterpolator
 from scipy.spatial import cKDTree
 
 from ..assembly import Assembly, tooth_transform
@@ -204,23 +205,24 @@ class TCA:
         tca.asm = assembly
         return tca
 
-    def gear_start(self, Q: Array) -> tuple[Array, Array]:
-        """Start values of the gear's native parameters for points ``Q (..., 3)`` (gear member
-        frame) near its flank: linear interpolation of the 21 × 21 flank samples over
-        ``(ρ, z)`` (their Delaunay triangulation), the nearest sample outside it. Measured on the
-        spiral bevel's contact grids (warm cycle): after the second Newton step of
-        :func:`~fegear.tca.solve.line_hit` 71 % of the lines have converged instead of 13 %
-        from the nearest sample, and the third evaluation of the exact flank is made only for
-        the others (one process: line_hit 3.45-3.67 → 3.13-3.35 s).
-        """
-        rz = np.stack([np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2]], -1)
-        interp = self.__dict__.get("_gear_interp")
-        if interp is None:
-            from scipy.interpolate import LinearNDInterpolator
+    @cached_property
+    def _gear_interp(self) -> LinearNDInterpolator:
+        """The gear's native parameters over ``(ρ, z)``, linear on the Delaunay triangulation of
+        its flank samples (built on first use: ~ms)."""
+        return LinearNDInterpolator(self.gtree.data, np.stack([self.ga, self.gb], -1))
 
-            interp = LinearNDInterpolator(self.gtree.data, np.stack([self.ga, self.gb], -1))
-            self.__dict__["_gear_interp"] = interp
-        ab = interp(rz)
+    def gear_start(self, rho: Array, z: Array) -> tuple[Array, Array]:
+        """Start values of the gear's native parameters for the Newton solves on its flank
+        (:func:`~fegear.tca.solve.line_hit`, :func:`~fegear.tca.solve.circle_hit`) at points of
+        radius ``rho`` and height ``z`` (gear member frame, any shape): linear interpolation of
+        the 21 × 21 flank samples over ``(ρ, z)``, the nearest sample outside their hull.
+        Measured on the spiral bevel's contact grids (warm cycle): after the second Newton step
+        of ``line_hit`` 71 % of the lines have converged instead of 13 % from the nearest
+        sample, and the third evaluation of the exact flank is made only for the others (one
+        process: line_hit 3.45-3.67 → 3.13-3.35 s).
+        """
+        rz = np.stack(np.broadcast_arrays(rho, z), -1)
+        ab = self._gear_interp(rz)
         out = ~np.isfinite(ab).all(axis=-1)
         if out.any():
             idx = self.gtree.query(rz[out])[1]
@@ -248,8 +250,7 @@ class TCA:
         Q = apply_points(T[:, None], P)
         rho, z = np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2]
         if a is None:
-            idx = self.gtree.query(np.stack([rho, z], -1))[1]
-            a, b = self.ga[idx], self.gb[idx]
+            a, b = self.gear_start(rho, z)
         a2, b2, p2, _, ok = circle_hit(self.fm2, None, a, b, rho, z)
         u2, v2 = self.fm2.flank(a2, b2, p2)
         ok = ok & in_bounds(self.fm2, u2, v2) & in_bounds(self.fm1, u, v)
@@ -449,8 +450,8 @@ class TCA:
         Tc = self._tooth_frames(np.array([phi1]), np.array([ts]))[0]
         # separation at each pair's closest point (closed position)
         Q, NQ = apply_points(Tc, P1), apply_vectors(Tc, N1)
-        idx = self.gtree.query(np.stack([np.hypot(Q[:, 0], Q[:, 1]), Q[:, 2]], -1))[1]
-        _, _, s, _, _, ok = line_hit(self.fm2, self.ga[idx], self.gb[idx], Q, NQ)
+        a2, b2 = self.gear_start(np.hypot(Q[:, 0], Q[:, 1]), Q[:, 2])
+        _, _, s, _, _, ok = line_hit(self.fm2, a2, b2, Q, NQ)
         back_mm = np.where(valid & ok, np.maximum(s, 0.0), 0.0)
         back_rad = np.where(valid, theta - ts, 0.0)
         if cp >= 0:
@@ -496,8 +497,8 @@ class TCA:
         for i in np.nonzero(valid)[0]:
             T = Tc[i]
             Q, NQ = apply_points(T, self.cP), apply_vectors(T, self.cN)
-            idx = self.gtree.query(np.stack([np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2]], -1))[1]
-            a2, b2, s, p2, n2, ok = line_hit(self.fm2, self.ga[idx], self.gb[idx], Q, NQ)
+            a2, b2 = self.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
+            a2, b2, s, p2, n2, ok = line_hit(self.fm2, a2, b2, Q, NQ)
             u2, v2 = self.fm2.flank(a2, b2, p2)
             ok = ok & in_bounds(self.fm2, u2, v2)
             pdot = -a.sense2 * np.stack([-p2[..., 1], p2[..., 0], np.zeros_like(s)], -1)

@@ -247,9 +247,7 @@ class SpiralBevelMap(FlankMap):
     def native_point(self, u, v):
         # the (u, v) -> (s, θ) Newton ends on an evaluation at the converged (s, θ): 1 of the
         # ~4 evaluations of a grid point saved
-        s, th, p, n, rs, rt = self._nf().native_evaluation(u, v)
-        self._cache["last"] = (p, rs, rt)
-        return s, th, p, n
+        return self._nf().native_evaluation(u, v)
 
     def _native_box(self):
         lo, hi = self._nf().box
