@@ -118,11 +118,19 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase | Ge
     """Validate a parsed TOML document and build the case (dispatch on ``[case] kind``)."""
     from fegear.io.gear_case import GEAR_KINDS, parse_gear_case
 
-    kind = data.get("case", {}).get("kind") if isinstance(data.get("case"), dict) else None
+    allowed = ", ".join(repr(k) for k in ("hertz_scene", *GEAR_KINDS))
+    # The kind decides the schema: without it no section list (the Hertz scene's or a gear
+    # pair's) can be right, so the message asks for the kind, not for other sections.
+    if "case" not in data:
+        raise InputError("case", "missing", f"a [case] section with kind = one of {allowed}")
+    if not isinstance(data["case"], dict):
+        raise InputError("case", data["case"], "a TOML table [case]")
+    kind = data["case"].get("kind")
+    if kind is None:
+        raise InputError("case.kind", "missing", f"one of {allowed} (required)")
     if kind in GEAR_KINDS:
         return parse_gear_case(data, source)
-    if kind is not None and kind != "hertz_scene":
-        allowed = ", ".join(repr(k) for k in ("hertz_scene", *GEAR_KINDS))
+    if kind != "hertz_scene":
         raise InputError("case.kind", kind, f"one of {allowed}")
     return parse_hertz_case(data, source)
 

@@ -4,16 +4,21 @@
 results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``). The case kind decides
 what runs:
 
-- gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity fe`` or
-  ``hertz``) or the unloaded TCA (``--fidelity tca``);
+- gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity hybrid``,
+  the default, ``fe`` or ``hertz``) or the unloaded TCA (``--fidelity tca``);
 - ``hertz_scene``: the FE Hertz check (``--fidelity fe | hybrid``, ``--study``, ``--backend``).
 
 With no CASE it runs the built-in seed face-gear case (``cases/face_gear_nominal.toml``: N2 160,
-N1 25, m 6.35 mm, 25°, pinion torque 350.14 N·m, fe level 0, 25 positions; about a minute cold on
-2 cores, the sector meshes and compliance operators are then cached).
+N1 25, m 6.35 mm, 25°, pinion torque 350.14 N·m, hybrid level 0, 25 positions; under a minute
+cold on 2 cores, the sector meshes and compliance operators are then cached).
 
-Progress goes to stderr (stages and positions); ``-q`` keeps only warnings and errors. Bad input
-ends with a one-line message and exit code 2; a failure of the analysis with exit code 1.
+Progress goes to stderr (stages and positions); ``-q`` keeps only warnings and errors. Warnings
+that change the meaning of a headline (positions left out of the TE peak-to-peak, a p_max not
+reported, a contact ratio below 1, contact lost, ``fe`` cells wider than the patch) are printed
+as ``warning: ...`` lines, also with ``-q``. Bad input, including an installation that cannot
+mesh (no contact anywhere, tip/root interference) and an output folder that cannot be written,
+ends with a one-line message and exit code 2 before the analysis; a failure of the analysis with
+exit code 1.
 """
 
 from __future__ import annotations
@@ -23,7 +28,6 @@ import logging
 import os
 import sys
 import time
-from pathlib import Path
 
 from fegear import __version__
 from fegear.errors import FegearError, InputError
@@ -51,9 +55,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--fidelity",
-        help="gear pairs: fe (FE loaded TCA) | hybrid (FE + half-space near field, resolves the "
-        "patch) | hertz (per-pair Hertz + lumped FE compliance) | "
-        "tca (unloaded, rigid); "
+        help="gear pairs: hybrid (FE + half-space near field, resolves the patch; the default) | "
+        "fe (pure FE; its cells are wider than the patch at practical levels) | hertz (per-pair "
+        "Hertz + lumped FE compliance) | tca (unloaded, rigid); "
         "Hertz scene: fe | hybrid (coarse FE + half-space near field)",
     )
     r.add_argument(
@@ -77,7 +81,7 @@ def _parser() -> argparse.ArgumentParser:
         "errors.dgamma_deg=-0.04:0.04:5 or load.torque2_Nm=100:400:4; repeat for a product",
     )
     s.add_argument("--out", default="sweep", help="sweep folder (default: ./sweep)")
-    s.add_argument("--fidelity", help="fe | hertz | tca; overrides the cases")
+    s.add_argument("--fidelity", help="hybrid | fe | hertz | tca; overrides the cases")
     s.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the cases")
     s.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     s.add_argument(
@@ -108,16 +112,24 @@ def _run(args: argparse.Namespace) -> int:
 def _run_gear(args: argparse.Namespace, case) -> int:
     from dataclasses import replace
 
+    from fegear.io.files import check_writable_folder
     from fegear.io.gear_case import build_pair
     from fegear.io.gear_output import write_gear_outputs
-    from fegear.io.gear_run import run_gear_case
+    from fegear.io.gear_run import report, run_gear_case
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
     if args.backend:
         case = replace(case, backend=args.backend)
-    out = Path(args.out)
+    out = check_writable_folder(args.out)  # before any work
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    warned: set[str] = set()
+
+    def warn(text: str) -> None:
+        if text not in warned:
+            warned.add(text)
+            print(f"warning: {text}", file=sys.stderr, flush=True)
+
     fid = args.fidelity or case.fidelity
     lvl = case.level if args.level is None else args.level
     if fid not in ("fe", "hertz", "hybrid", "tca"):
@@ -135,10 +147,11 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         + f", {case.n_positions} positions, out {out}/"
     )
     stage_t = {"t": t_start}
+    checks = "geometry, assembly and engagement checks (tip clearance, TCA of the positions)"
     if fid in ("fe", "hybrid"):
         layer = " and their layer below the flanks" if fid == "hybrid" else ""
         labels = {
-            "geometry": "[1/5] geometry and assembly",
+            "geometry": f"[1/5] {checks}",
             "models": f"[2/5] sector meshes and compliance operators{layer} (cached after the "
             "first run)",
             "positions": "[3/5] mesh positions (TCA + contact)",
@@ -147,15 +160,15 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         }
     elif fid == "hertz":
         labels = {
-            "geometry": "[1/4] geometry and assembly",
+            "geometry": f"[1/4] {checks}",
             "models": "[2/4] sector meshes and compliance operators (cached after the first run)",
             "positions": "[3/4] mesh positions (TCA + Hertz laws)",
             "writing": "[4/4] writing outputs",
         }
     else:
         labels = {
-            "geometry": "[1/3] geometry and assembly",
-            "tca": "[2/3] unloaded TCA over the cycle",
+            "geometry": "[1/3] geometry, assembly and tip clearance",
+            "tca": "[2/3] unloaded TCA over the cycle and engagement checks",
             "writing": "[3/3] writing outputs",
         }
 
@@ -175,27 +188,40 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         progress=progress,
         pair=pair,
         workers=args.workers,
+        notify=warn,
     )
     progress("writing", None, None)
     paths = write_gear_outputs(out, run)
+    rep = report(run)
     if run.cycle is not None:
-        c = run.cycle
+        used = f" over {rep.positions_used} of {rep.n_positions} positions"
         say(
-            f"    TE p-p unloaded {c.te_pp_unloaded_arcsec:.2f} arcsec, loaded "
-            f"{c.te_pp_loaded_arcsec:.2f} arcsec; loaded contact ratio "
-            f"{c.contact_ratio_loaded:.2f}; p_max {c.p_max_MPa:.0f} MPa"
+            f"    TE p-p unloaded {_value(rep.te_pp_unloaded_arcsec, '.2f', 'arcsec')}, loaded "
+            f"{_value(rep.te_pp_loaded_arcsec, '.2f', 'arcsec')}"
+            + (used if rep.te_pp_loaded_arcsec is not None else "")
+            + f"; loaded contact ratio {_value(rep.contact_ratio_loaded, '.2f', '')}"
         )
-        inner = [q.p_max_MPa for p in c.positions for q in p.pairs if not q.edge_contact]
-        if any(q.edge_contact for p in c.positions for q in p.pairs):
+        if rep.p_max_MPa is not None:
+            k, j = rep.p_max_pair
             say(
-                "    edge contact at some positions (pressure there is singular, grid-dependent); "
-                f"p_max away from the edges {max(inner, default=0.0):.0f} MPa"
+                f"    p_max {rep.p_max_MPa:.0f} MPa away from the flank edges (position "
+                f"{rep.p_max_position}, pair ({k}, {j}))"
             )
-        n_warn = sum(bool(p.warnings) for p in c.positions)
-        if n_warn:
-            say(f"    warning: {n_warn} positions with warnings (see summary.json)")
+        if rep.p_max_edge_MPa is not None:
+            k, j = rep.p_max_edge_pair
+            say(
+                f"    edge contact at {len(rep.edge_positions)} of {rep.n_positions} positions: "
+                f"up to {rep.p_max_edge_MPa:.0f} MPa at the {', '.join(rep.p_max_edge_edges)} "
+                f"(position {rep.p_max_edge_position}, pair ({k}, {j})): singular, "
+                "grid-dependent (cycle.p_max_edge_MPa)"
+            )
     else:
-        say(f"    unloaded TE p-p {run.tca.te_peak_to_peak_arcsec:.2f} arcsec (TCA only)")
+        say(f"    unloaded TE p-p {_value(rep.te_pp_unloaded_arcsec, '.2f', 'arcsec')} (TCA only)")
+    for w in rep.warnings:
+        warn(w)
+    n_other = sum(bool(p.warnings) for p in run.cycle.positions) if run.cycle is not None else 0
+    if n_other:
+        say(f"    {n_other} positions with solver notes (summary.json: positions[i].warnings)")
     kinds = (
         "summary.json, cycle.pvd, vtk/, *.png" if run.cycle is not None else "summary.json, *.png"
     )
@@ -203,8 +229,16 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     return 0
 
 
+def _value(x: float | None, fmt: str, unit: str) -> str:
+    """A headline number, or "not reported" (never a 0 standing for nothing)."""
+    if x is None:
+        return "not reported"
+    return f"{format(x, fmt)} {unit}".rstrip()
+
+
 def _run_hertz(args: argparse.Namespace, case) -> int:
     from fegear.convergence import observed_rate
+    from fegear.io.files import check_writable_folder
     from fegear.io.hertz_output import write_hertz_outputs
     from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
 
@@ -224,7 +258,7 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
             study_levels = tuple(sorted({int(x) for x in args.study.split(",")}))
         except ValueError as exc:
             raise InputError("--study", args.study, "comma-separated integers") from exc
-    out = Path(args.out)
+    out = check_writable_folder(args.out)  # before any work
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr))
     say(
         f"fegear {__version__}: case {case.name!r} ({case.source}), fidelity {fidelity}, "
@@ -268,10 +302,12 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
+    from fegear.io.files import check_writable_folder
     from fegear.sweep import build_items, require_dask, run_sweep
 
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     t_start = time.perf_counter()
+    check_writable_folder(args.out)
     items = build_items(args.case, args.grid, fidelity=args.fidelity, level=args.level)
     if args.workers < 1:
         raise InputError("--workers", args.workers, "an integer >= 1")

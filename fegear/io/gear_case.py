@@ -15,7 +15,7 @@ Schema (``*`` = required)::
     [errors]    intersecting axes (face_gear, spiral_bevel): dE_mm, dA1_mm, dA2_mm, dgamma_deg
                 parallel axes (spur): da_mm, f_sigma_delta_mm, f_sigma_beta_mm, dA1_mm, dA2_mm
                 (all default 0; sign conventions in :mod:`fegear.assembly`)
-    [analysis]  fidelity ("fe" | "hertz" | "hybrid" | "tca"), level (0..4), n_positions (>= 2),
+    [analysis]  fidelity ("hybrid" default | "fe" | "hertz" | "tca"), level (0..4), n_positions,
                 n_teeth (3..9; default: the teeth that can touch + one neighbour each side),
                 backend ("auto" | "pardiso" | "superlu")
     [material]  E_MPa (> 0), nu (in (-1, 0.5))    — both members
@@ -50,17 +50,25 @@ from fegear.errors import InputError
 
 __all__ = [
     "GEAR_KINDS",
+    "DEFAULT_FIDELITY",
     "FIDELITIES",
     "N_LEVELS",
     "GearCase",
     "GearPair",
     "parse_gear_case",
     "build_pair",
+    "assemble",
+    "error_fields",
 ]
 
 GEAR_KINDS = ("face_gear", "spur", "spiral_bevel")
-#: Fidelities of the gear pairs available now (DESIGN §9): rigid TCA and pure FE.
+#: Fidelities of the gear pairs (DESIGN §9).
 FIDELITIES = ("fe", "hertz", "hybrid", "tca")
+#: The fidelity of a gear case that does not name one: the one that resolves the contact patch
+#: at the default (coarsest) level. ``fe`` level 0 does not: its cells are wider than the patch
+#: (FZG: p_max 126-160 MPa where ``hybrid``, ``hertz`` and line Hertz give about 1100 MPa; seed
+#: face gear: loaded TE p-p 2.39″ against 0.43″ at ``hybrid``).
+DEFAULT_FIDELITY = "hybrid"
 #: Sector mesh levels 0 … N_LEVELS − 1 (:data:`fegear.mesh.sector.FINE`).
 N_LEVELS = 5
 
@@ -169,7 +177,7 @@ class GearCase:
     load_key: str
     load_value: float
     errors: InstallationErrors = field(default_factory=InstallationErrors)
-    fidelity: str = "fe"
+    fidelity: str = "hybrid"
     level: int = 0
     n_positions: int = 25
     n_teeth: int | None = None
@@ -422,7 +430,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     if "speed_rpm" in load and load["speed_rpm"] < 0:
         raise InputError("load.speed_rpm", load["speed_rpm"], ">= 0")
 
-    fidelity = ana.get("fidelity", "fe")
+    fidelity = ana.get("fidelity", DEFAULT_FIDELITY)
     if fidelity not in FIDELITIES:
         raise InputError(
             "analysis.fidelity", fidelity, f"one of {FIDELITIES} for gear pairs", _FIDELITY_NOTE
@@ -594,3 +602,24 @@ def build_pair(case: GearCase) -> GearPair:
         raise _renamed(exc, None, _BEVEL_FIELDS, case) from exc
     side = p.get("side", "drive")
     return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
+
+
+def error_fields(case: GearCase) -> list[tuple[str, float]]:
+    """``[(case-file key, value)]`` of the case's non-zero installation errors
+    (``("errors.da_mm", 9.5)``)."""
+    return [
+        (f"errors.{k}", float(getattr(case.errors, k)))
+        for k in _error_keys(case.kind)
+        if getattr(case.errors, k) != 0.0
+    ]
+
+
+def assemble(case: GearCase, pair: GearPair, errors: InstallationErrors):
+    """The assembly of ``pair`` with other installation ``errors`` (same members and flanks)."""
+    from fegear.assembly import face_gear_assembly, involute_assembly, spiral_bevel_assembly
+
+    if case.kind == "face_gear":
+        return face_gear_assembly(pair.gear, errors, pair.pinion)
+    if case.kind == "spur":
+        return involute_assembly(pair.pinion, pair.gear, errors)
+    return spiral_bevel_assembly(pair.spiral_bevel, case.pair.get("side", "drive"), errors)

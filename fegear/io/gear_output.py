@@ -2,9 +2,17 @@
 
 Files written to the output folder (each one atomically: complete or absent):
 
-- ``summary.json`` — inputs, per position (pinion angle, unloaded/loaded TE, pairs with force,
-  load share, p_max, patch axes, contact point in the fixed frame, edge flag), cycle values,
-  solver residuals, timings, versions, units. Keys other tools rely on:
+- ``summary.json`` — inputs, per position (pinion angle, unloaded/loaded TE, status, pairs with
+  force, load share, p_max, patch axes, contact point in the fixed frame, edge flag and edges),
+  cycle values, solver residuals, timings, versions, units. Headlines mean what they say
+  (:func:`fegear.io.gear_run.report`): ``cycle.te_pp_loaded_arcsec`` over the usable positions
+  only (``te_pp_loaded_positions_used``; ``excluded_positions`` with their reasons: contact
+  lost, or degenerate: a loaded patch the cells do not resolve), ``cycle.p_max_MPa`` the largest
+  pressure away from the flank edges, ``cycle.p_max_edge_MPa`` the edge value beside it
+  (``p_max_edge_at``: position, pair, edges named), and ``null`` with a ``*_reason`` where
+  nothing physical can be reported, never 0. The engagement checks made before the analysis:
+  ``cycle.tip_clearance_mm``, ``cycle.unloaded_interior_contact_fraction`` (the contact ratio
+  when below 1), ``cycle.positions_without_unloaded_contact``. Keys other tools rely on:
   ``cycle.te_pp_unloaded_arcsec``, ``cycle.te_pp_loaded_arcsec``,
   ``cycle.contact_ratio_loaded``, ``cycle.p_max_MPa``, ``positions[i].pinion_angle_deg``,
   ``positions[i].te_loaded_arcsec``, ``positions[i].pairs[j].load_share``,
@@ -15,7 +23,9 @@ Files written to the output folder (each one atomically: complete or absent):
   in its assembled position at position ``i`` (fixed frame, mm; the gear at its unloaded
   TCA-closed angle ``ratio·φ1 + TE_unloaded``, the elastic lag is not added), linear tets, with
   point data ``displacement_mm`` (fixed-frame components of ``u = K⁻¹ P F``; *Warp By Vector*),
-  ``pressure_MPa`` (the pressure of the contact cell over each working-flank vertex, else 0) and
+  ``pressure_MPa`` (the pressure of the contact cell over each working-flank vertex, raised to
+  that of the loaded cells whose nearest vertex it is, else 0: a display of the patch on the
+  element mesh; the exact field is in the contact cells) and
   ``in_contact`` (1 on loaded flank vertices).
 - ``vtk/contact_cells_<i>.vtu`` — the contact cells of all pairs as quads on the pinion flank
   (fixed frame) with cell data ``force_N``, ``pressure_MPa``, ``area_mm2`` (so that
@@ -41,7 +51,7 @@ import numpy as np
 
 from fegear.geometry.transforms import apply_points, apply_vectors
 from fegear.io.files import atomic_write, write_json
-from fegear.io.gear_run import GearRun
+from fegear.io.gear_run import GearRun, report
 from fegear.io.records import solver_record, versions
 
 __all__ = ["write_gear_outputs", "gear_summary", "write_pvd"]
@@ -52,6 +62,14 @@ ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 def _f(x: float) -> float | None:
     x = float(x)
     return x if math.isfinite(x) else None
+
+
+def _f_or_none(x: float | None) -> float | None:
+    return None if x is None else _f(x)
+
+
+def _num(x: float | None, fmt: str) -> str:
+    return "not reported" if x is None else format(x, fmt)
 
 
 UNITS = {
@@ -80,6 +98,11 @@ def _pair_row(q, k: int) -> dict[str, Any]:
         "semi_minor_mm": q.semi_minor_mm,
         "n_active_cells": q.n_active,
         "edge_contact": q.edge_contact,
+        "edges": list(q.edges),
+        "p_interior_MPa": _f_or_none(q.p_interior_MPa),
+        "p_edge_MPa": _f_or_none(q.p_edge_MPa),
+        "cells_across_patch": _f_or_none(q.cells_across),
+        "resolved": bool(q.resolved),
         "in_contact": loaded,
         "contact_point_mm": [float(x) for x in q.contact_point] if loaded else None,
     }
@@ -99,6 +122,9 @@ def _fe_positions(run: GearRun) -> list[dict[str, Any]]:
                 "te_loaded_urad": p.te_loaded_arcsec / ARCSEC_PER_RAD * 1e6,
                 "elastic_lag_arcsec": p.theta * ARCSEC_PER_RAD,
                 "n_pairs_in_contact": p.n_pairs_in_contact,
+                "status": p.status,
+                "status_reason": p.status_reason,
+                "unloaded_contact": bool(p.unloaded_contact),
                 "total_force_N": float(s.force.sum()) if s.force.size else 0.0,
                 "p_max_MPa": p.p_max_MPa,
                 "pairs": [_pair_row(q, k) for k, q in enumerate(p.pairs)],
@@ -165,16 +191,56 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
         },
         "inputs": case.to_dict(),
     }
+    rep = report(run)
+    eng = run.engagement
+    checks = {}
+    if eng is not None:
+        cl = eng.clearance
+        checks = {
+            "tip_clearance_mm": None
+            if cl is None
+            else {"pinion_tip": _f(cl.pinion_tip_mm), "gear_tip": _f(cl.gear_tip_mm)},
+            "unloaded_interior_contact_fraction": _f(eng.handover.interior_fraction),
+            "contact_ratio_unloaded_below_1": _f_or_none(eng.contact_ratio_below_one),
+            "handover_missed_by_positions": bool(eng.missed_handover),
+            "positions_without_unloaded_contact": list(eng.lost),
+        }
     if run.cycle is not None:
         c = run.cycle
         sols = [p.solution for p in c.positions]
         doc["cycle"] = {
             "n_positions": len(c.positions),
             "torque2_Nm": c.torque2_Nmm / 1000.0,
-            "te_pp_unloaded_arcsec": c.te_pp_unloaded_arcsec,
-            "te_pp_loaded_arcsec": c.te_pp_loaded_arcsec,
-            "contact_ratio_loaded": c.contact_ratio_loaded,
-            "p_max_MPa": c.p_max_MPa,
+            "te_pp_unloaded_arcsec": _f_or_none(rep.te_pp_unloaded_arcsec),
+            "te_pp_unloaded_reason": rep.te_pp_unloaded_reason,
+            "te_pp_loaded_arcsec": _f_or_none(rep.te_pp_loaded_arcsec),
+            "te_pp_loaded_reason": rep.te_pp_loaded_reason,
+            "te_pp_loaded_positions_used": rep.positions_used,
+            "excluded_positions": [
+                {
+                    "index": e.index,
+                    "pinion_angle_deg": math.degrees(e.phi1),
+                    "status": e.status,
+                    "reason": e.reason,
+                }
+                for e in rep.excluded
+            ],
+            "contact_ratio_loaded": _f_or_none(rep.contact_ratio_loaded),
+            "contact_ratio_reason": rep.contact_ratio_reason,
+            "p_max_MPa": _f_or_none(rep.p_max_MPa),
+            "p_max_reason": rep.p_max_reason,
+            "p_max_at": None
+            if rep.p_max_MPa is None
+            else {"position": rep.p_max_position, "pair": list(rep.p_max_pair)},
+            "p_max_edge_MPa": _f_or_none(rep.p_max_edge_MPa),
+            "p_max_edge_at": None
+            if rep.p_max_edge_MPa is None
+            else {
+                "position": rep.p_max_edge_position,
+                "pair": list(rep.p_max_edge_pair),
+                "edges": list(rep.p_max_edge_edges),
+            },
+            "positions_with_edge_contact": list(rep.edge_positions),
             "max_pairs_in_contact": int(c.n_in_contact.max()) if c.n_in_contact.size else 0,
             "positions_without_contact": int(np.sum(c.n_in_contact == 0)),
             "max_equilibrium_residual": max((s.equilibrium_residual for s in sols), default=0),
@@ -182,6 +248,7 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
                 (s.complementarity_residual for s in sols), default=0.0
             ),
             "max_penetration_mm": max((s.max_penetration for s in sols), default=0.0),
+            **checks,
         }
         if c.zone is not None:
             # What the sectors modelled: their teeth, the pairs with a fine zone and the
@@ -201,25 +268,27 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
             for mf in run.members
         }
         doc["timings_s"] = {**run.seconds, **{f"ltca.{k}": v for k, v in c.seconds.items()}}
-        warnings = sorted({w for p in c.positions for w in p.warnings})
+        warnings = list(rep.warnings) + sorted({w for p in c.positions for w in p.warnings})
     else:
         r = run.tca
         doc["cycle"] = {
             "n_positions": int(r.phi1.size),
             "torque2_Nm": case.torque2_Nmm / 1000.0,
-            "te_pp_unloaded_arcsec": r.te_peak_to_peak_arcsec,
+            "te_pp_unloaded_arcsec": _f_or_none(rep.te_pp_unloaded_arcsec),
+            "te_pp_unloaded_reason": rep.te_pp_unloaded_reason,
             "te_pp_loaded_arcsec": None,
+            "te_pp_loaded_reason": rep.te_pp_loaded_reason,
             "contact_ratio_loaded": None,
             "p_max_MPa": None,
+            "p_max_reason": rep.p_max_reason,
             "hertz_p0_max_MPa": _f(r.hertz_p0_MPa.max()) if r.hertz_p0_MPa.size else None,
             "positions_without_contact": int(np.sum(~r.has_contact)),
             "paint_thickness_mm": r.paint_mm,
+            **checks,
         }
         doc["positions"] = _tca_positions(run)
         doc["timings_s"] = dict(run.seconds)
-        warnings = []
-        if case.kind == "spiral_bevel":
-            warnings.append("unloaded TCA only: the spiral bevel loaded analysis is not available")
+        warnings = list(rep.warnings)
     doc["warnings"] = warnings
     doc["files"] = files or []
     doc["versions"] = versions()
@@ -287,6 +356,13 @@ def _node_pressure(mf, i: int, pos, X: np.ndarray) -> np.ndarray:
     d, j = cKDTree(centers).query(X[mf.flank_nodes])
     ok = d <= 1.05 * half[j]
     p[mf.flank_nodes[ok]] = pres[j[ok]]
+    # Cells much smaller than the elements (hybrid: 0.03 mm across a patch between vertices
+    # 2 mm apart) lie over no vertex: each loaded cell also raises its nearest flank vertex to
+    # its pressure, so the patch shows on the sector mesh (the exact field is in the cells).
+    loaded = pres > 0
+    if loaded.any():
+        _, v = cKDTree(X[mf.flank_nodes]).query(centers[loaded])
+        np.maximum.at(p, mf.flank_nodes[v], pres[loaded])
     return p
 
 
@@ -376,9 +452,11 @@ def _plot_te(out: Path, run: GearRun) -> Path:
     ax.plot(deg, c.te_loaded_arcsec, "s-", ms=3, label="loaded")
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("TE (arcsec)")
+    rep = report(run)
     ax.set_title(
-        f"{_title(run)}\nTE p-p unloaded {c.te_pp_unloaded_arcsec:.2f}, "
-        f"loaded {c.te_pp_loaded_arcsec:.2f} arcsec",
+        f"{_title(run)}\nTE p-p unloaded {_num(rep.te_pp_unloaded_arcsec, '.2f')}, loaded "
+        f"{_num(rep.te_pp_loaded_arcsec, '.2f')} arcsec "
+        f"(over {rep.positions_used} of {rep.n_positions} positions)",
         fontsize=9,
     )
     ax.grid(alpha=0.3)
@@ -407,8 +485,8 @@ def _plot_load_share(out: Path, run: GearRun) -> Path:
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("load share (torque fraction)")
     ax.set_ylim(-0.05, 1.05)
-    ax.set_title(f"{_title(run)}\nloaded contact ratio {run.cycle.contact_ratio_loaded:.2f}",
-                 fontsize=9)  # fmt: skip
+    cr = report(run).contact_ratio_loaded
+    ax.set_title(f"{_title(run)}\nloaded contact ratio {_num(cr, '.2f')}", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _save(fig, out / "load_share.png")
@@ -424,7 +502,16 @@ def _plot_p_max(out: Path, run: GearRun) -> Path:
     ax.plot(deg, [p.p_max_MPa for p in c.positions], "k-", lw=1.5, label="position max")
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("largest cell pressure p_max (MPa)")
-    ax.set_title(f"{_title(run)}\ncycle p_max {c.p_max_MPa:.0f} MPa", fontsize=9)
+    rep = report(run)
+    edge = (
+        f"; at the edges {rep.p_max_edge_MPa:.0f} MPa (singular)"
+        if rep.p_max_edge_MPa is not None
+        else ""
+    )
+    ax.set_title(
+        f"{_title(run)}\ncycle p_max away from the edges {_num(rep.p_max_MPa, '.0f')} MPa{edge}",
+        fontsize=9,
+    )
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _save(fig, out / "p_max.png")

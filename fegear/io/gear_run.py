@@ -30,10 +30,27 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from fegear.errors import InputError
-from fegear.io.gear_case import FIDELITIES, N_LEVELS, GearCase, GearPair, build_pair
+from fegear.errors import DesignError, InputError
+from fegear.io.gear_case import (
+    FIDELITIES,
+    N_LEVELS,
+    GearCase,
+    GearPair,
+    assemble,
+    build_pair,
+    error_fields,
+)
 
-__all__ = ["GearRun", "MemberField", "run_gear_case", "displacements"]
+__all__ = [
+    "Engagement",
+    "GearRun",
+    "MemberField",
+    "Report",
+    "check_engagement",
+    "displacements",
+    "report",
+    "run_gear_case",
+]
 
 log = logging.getLogger(__name__)
 
@@ -73,6 +90,165 @@ class MemberField:
     solver: str
 
 
+#: A tip closer than this to the mate's root (mm) is an interference (the clearance is computed
+#: to well below a micrometre, :func:`fegear.tca.engagement.tip_root_clearance`).
+INTERFERENCE_TOL_MM = 1e-4
+
+
+@dataclass(frozen=True)
+class Engagement:
+    """How the flanks engage, checked before the loaded analysis (:func:`check_engagement`).
+
+    Attributes
+    ----------
+    clearance
+        Tip-to-root clearances (:class:`fegear.tca.engagement.Clearance`).
+    handover
+        Interior contact over the cycle (:class:`fegear.tca.engagement.Handover`).
+    phi1
+        ``(n,)`` rad, the positions of the run.
+    has_contact
+        ``(n,)`` bool, the unloaded TCA found contact there.
+    missed_handover
+        The interior contact covers less than the whole cycle (contact ratio below 1) and no
+        position of the run falls where it does not: the run's TE peak-to-peak and contact
+        ratio do not see the handover.
+    errors
+        ``[(case-file key, value)]`` of the non-zero installation errors.
+    warnings
+        Terminal warnings (they change the meaning of a headline).
+    """
+
+    clearance: Any
+    handover: Any
+    phi1: Array
+    has_contact: NDArray[np.bool_]
+    missed_handover: bool
+    errors: tuple[tuple[str, float], ...]
+    warnings: tuple[str, ...]
+
+    @property
+    def contact_ratio_below_one(self) -> float | None:
+        """The unloaded contact ratio when it is below 1 (the interior fraction), else None."""
+        f = float(self.handover.interior_fraction)
+        return f if f < 1.0 else None
+
+    @property
+    def lost(self) -> tuple[int, ...]:
+        """Positions of the run without unloaded contact."""
+        return tuple(int(i) for i in np.flatnonzero(~self.has_contact))
+
+
+def _fields_text(errors) -> str:
+    return ", ".join(f"{k} = {v:g}" for k, v in errors) or "no installation errors"
+
+
+def _check_clearance(case: GearCase, pair: GearPair):
+    """Refuse a tip running into the mate's root (:class:`~fegear.errors.InputError` naming the
+    installation-error field that causes it and the depth; a :class:`~fegear.errors.DesignError`
+    if the error-free pair already interferes)."""
+    from dataclasses import replace
+
+    from fegear.assembly import InstallationErrors
+    from fegear.tca.engagement import tip_root_clearance
+
+    c = tip_root_clearance(pair.pinion, pair.gear, pair.assembly)
+    if c.interference_mm <= INTERFERENCE_TOL_MM:
+        return c
+    who = c.worse
+    mate = "gear" if who == "pinion" else "pinion"
+    errs = error_fields(case)
+    nominal = tip_root_clearance(pair.pinion, pair.gear, assemble(case, pair, InstallationErrors()))
+    what = (
+        f"tip/root interference: the {who} tip runs {c.interference_mm:.3f} mm into the {mate} "
+        f"root; the tip clearance without errors is "
+        f"{min(nominal.pinion_tip_mm, nominal.gear_tip_mm):.3f} mm"
+    )
+    if not errs or nominal.interference_mm > INTERFERENCE_TOL_MM:
+        raise DesignError(
+            "pair", "tip/root interference", "a pair whose tips clear the roots", what
+        )
+    culprits = []
+    for key, value in errs:
+        one = replace(InstallationErrors(), **{key.split(".", 1)[1]: value})
+        alone = tip_root_clearance(pair.pinion, pair.gear, assemble(case, pair, one))
+        if alone.interference_mm > INTERFERENCE_TOL_MM:
+            culprits.append((key, value))
+    named = culprits or errs
+    field = ", ".join(k for k, _ in named)
+    value = named[0][1] if len(named) == 1 else [v for _, v in named]
+    raise InputError(
+        field, value, "an installation error that keeps the tips out of the roots", what
+    )
+
+
+def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) -> Engagement:
+    """Every way the contact can fail, decided before the loaded analysis.
+
+    ``tca``, ``positions``: the TCA of the run's positions (:func:`fegear.tca.cached.cached_tca`,
+    the one the loaded analysis reads back); ``clearance``: the pair's tip/root clearances
+    (checked first: an interference is refused before any TCA).
+
+    Raises
+    ------
+    InputError
+        No position of the cycle has contact: the flanks do not meet (naming the installation
+        errors that separate them).
+    """
+    from fegear.tca.engagement import cached_handover
+
+    errs = tuple(error_fields(case))
+    has = np.array([p.has_contact for p in positions], dtype=bool)
+    phi1 = np.array([p.phi1 for p in positions], dtype=float)
+    n = len(positions)
+    if not has.any():
+        field = ", ".join(k for k, _ in errs) or "pair"
+        value = errs[0][1] if len(errs) == 1 else [v for _, v in errs] if errs else "as designed"
+        raise InputError(
+            field,
+            value,
+            "installation errors under which the flanks meet",
+            f"no contact anywhere: the flanks do not meet at any of the {n} positions of the "
+            f"cycle; the teeth are separated by {_fields_text(errs)}",
+        )
+    h = cached_handover(pair.pinion, pair.gear, pair.assembly, tca.opt, tca)
+    warnings = []
+    lost = np.flatnonzero(~has)
+    if lost.size:
+        where = ", ".join(f"{i} (φ1 = {np.degrees(phi1[i]):.3f}°)" for i in lost)
+        warnings.append(
+            f"contact lost at {lost.size} of {n} positions: {where}; the flanks do not meet "
+            f"there ({_fields_text(errs)}); the TE peak-to-peak leaves them out"
+        )
+    missed = False
+    if h.interior_fraction < 1.0:
+        pct = 100.0 * (1.0 - h.interior_fraction)
+        spans = ", ".join(f"{np.degrees(a):.2f}° to {np.degrees(b):.2f}°" for a, b in h.intervals)
+        text = (
+            f"unloaded contact ratio {h.interior_fraction:.3f} < 1 ({_fields_text(errs)}): over "
+            f"{pct:.1f} % of each mesh cycle (φ1 {spans}) the contact is at a tip or root edge "
+            "or lost"
+        )
+        inside = h.covers(phi1)
+        if not inside.any():
+            missed = True
+            need = int(np.ceil(1.0 / max(1.0 - h.interior_fraction, 1e-9))) + 1
+            text += (
+                f"; none of the {n} positions falls there, so their TE peak-to-peak and contact "
+                f"ratio would not see it: not reported (run with n_positions >= {need})"
+            )
+        warnings.append(text)
+    return Engagement(
+        clearance=clearance,
+        handover=h,
+        phi1=phi1,
+        has_contact=has,
+        missed_handover=missed,
+        errors=errs,
+        warnings=tuple(warnings),
+    )
+
+
 @dataclass(frozen=True)
 class GearRun:
     """Everything a gear-case run produced (input of the writers).
@@ -93,6 +269,8 @@ class GearRun:
         The two :class:`MemberField` (fidelity ``"fe"``), else empty.
     seconds
         Wall time per stage.
+    engagement
+        What :func:`check_engagement` found before the analysis.
     """
 
     case: GearCase
@@ -102,6 +280,7 @@ class GearRun:
     tca: Any = None
     members: tuple[MemberField, ...] = ()
     seconds: dict[str, float] = field(default_factory=dict)
+    engagement: Engagement | None = None
 
     @property
     def fidelity(self) -> str:
@@ -222,6 +401,7 @@ def run_gear_case(
     progress: Progress | None = None,
     pair: GearPair | None = None,
     workers: int | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> GearRun:
     """Run a gear case at its (or the given) fidelity and level.
 
@@ -240,14 +420,22 @@ def run_gear_case(
     workers
         Processes for the mesh positions (:mod:`fegear.ltca.cycle`); None: one per core. A
         sweep, which runs its items in parallel already, passes 1.
+    notify
+        ``notify(text)``: called with each warning of the engagement checks as soon as they
+        are made, before the loaded analysis (they are in ``GearRun.engagement`` too).
 
     Raises
     ------
     InputError
-        Bad overrides or design data.
+        Bad overrides or design data; an installation under which the flanks cannot mesh: no
+        contact at any position (naming the installation errors), or a tip running into the
+        mate's root (naming the error and the depth). Both are decided before any FE work.
     """
     from fegear.ltca import LTCAOptions, build_models, run_ltca
-    from fegear.tca import TCAOptions, reference_phase, run_tca
+    from fegear.ltca.cycle import cycle_tca
+    from fegear.tca import TCAOptions
+    from fegear.tca.cached import cached_tca
+    from fegear.tca.cycle import cycle_result
 
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
@@ -255,6 +443,7 @@ def run_gear_case(
     t0 = time.perf_counter()
     say("geometry", None, None)
     pair = pair if pair is not None else build_pair(case)
+    clearance = _check_clearance(case, pair)  # interference: refused before any TCA
     seconds["geometry"] = time.perf_counter() - t0
 
     if case.fidelity == "tca":
@@ -262,10 +451,17 @@ def run_gear_case(
         say("tca", None, None)
         opt = TCAOptions(n_positions=case.n_positions, E_MPa=case.E_MPa, nu=case.nu,
                          pinion_torque_Nm=case.torque2_Nmm / case.ratio / 1000.0)  # fmt: skip
-        asm = pair.assembly.with_phase2(reference_phase(pair.pinion, pair.gear, pair.assembly, opt))
-        r = run_tca(pair.pinion, pair.gear, asm, opt, calibrate=False)
+        n = case.n_positions
+        phi1 = -np.pi / pair.assembly.n1 + 2 * np.pi / pair.assembly.n1 * np.arange(n) / n
+        tca, positions, _ = cached_tca(pair.pinion, pair.gear, pair.assembly, opt, phi1)
+        eng = check_engagement(case, pair, tca, positions, clearance)
+        for w in eng.warnings:
+            (notify or log.warning)(w)
+        r = cycle_result(list(positions), opt.paint_mm, tca)
         seconds["tca"] = time.perf_counter() - t0
-        return GearRun(case=case, pair=pair, assembly=asm, tca=r, seconds=seconds)
+        return GearRun(
+            case=case, pair=pair, assembly=tca.asm, tca=r, seconds=seconds, engagement=eng
+        )
 
     opt = LTCAOptions(
         n_positions=case.n_positions,
@@ -277,6 +473,12 @@ def run_gear_case(
         fidelity=case.fidelity,
         workers=workers,
     )
+    t0 = time.perf_counter()
+    tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
+    eng = check_engagement(case, pair, tca, positions, clearance)  # before the FE work
+    for w in eng.warnings:
+        (notify or log.warning)(w)
+    seconds["checks"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     say("models", None, None)
     models = build_models(pair.pinion, pair.gear, pair.assembly, opt)
@@ -297,7 +499,7 @@ def run_gear_case(
         # the load grew the contact zone: the cycle ran on other sectors (cached, read back)
         models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cycle.zone)
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
-    run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds)
+    run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng)
     if case.fidelity == "hertz":  # no contact grid: no cell loads, no displacement fields
         return run
     t0 = time.perf_counter()
@@ -305,5 +507,175 @@ def run_gear_case(
     members = displacements(pair, asm, models, cycle, run.phi2)
     seconds["displacements"] = time.perf_counter() - t0
     return GearRun(
-        case=case, pair=pair, assembly=asm, cycle=cycle, members=members, seconds=seconds
+        case=case,
+        pair=pair,
+        assembly=asm,
+        cycle=cycle,
+        members=members,
+        seconds=seconds,
+        engagement=eng,
+    )
+
+
+@dataclass(frozen=True)
+class Report:
+    """The headline numbers of a run as ``summary.json`` and the terminal report them: each
+    means what it says, None with the reason beside it where nothing physical can be reported
+    (DESIGN §10), and the warnings that change the meaning of a headline.
+
+    Attributes
+    ----------
+    n_positions
+        Positions of the run.
+    te_pp_unloaded_arcsec, te_pp_unloaded_reason
+        Unloaded TE peak-to-peak over the positions with unloaded contact.
+    te_pp_loaded_arcsec, te_pp_loaded_reason, positions_used, excluded
+        Loaded TE peak-to-peak over the usable positions (``positions_used`` of them;
+        ``excluded``: :class:`fegear.ltca.results.Excluded`, lost or degenerate).
+    contact_ratio_loaded, contact_ratio_reason
+        Mean number of loaded pairs.
+    p_max_MPa, p_max_reason, p_max_position, p_max_pair
+        Largest pressure away from the flank edges, where.
+    p_max_edge_MPa, p_max_edge_position, p_max_edge_pair, p_max_edge_edges, edge_positions
+        Largest pressure at a flank edge (singular), where, which edges; the usable positions
+        with an edge contact.
+    interior_fraction
+        Part of the cycle with interior unloaded contact (the contact ratio when below 1).
+    warnings
+        Warnings for the terminal (and ``summary.json``), in order.
+    """
+
+    n_positions: int
+    te_pp_unloaded_arcsec: float | None
+    te_pp_unloaded_reason: str
+    te_pp_loaded_arcsec: float | None = None
+    te_pp_loaded_reason: str = ""
+    positions_used: int = 0
+    excluded: tuple = ()
+    contact_ratio_loaded: float | None = None
+    contact_ratio_reason: str = ""
+    p_max_MPa: float | None = None
+    p_max_reason: str = ""
+    p_max_position: int | None = None
+    p_max_pair: tuple[int, int] | None = None
+    p_max_edge_MPa: float | None = None
+    p_max_edge_position: int | None = None
+    p_max_edge_pair: tuple[int, int] | None = None
+    p_max_edge_edges: tuple[str, ...] = ()
+    edge_positions: tuple[int, ...] = ()
+    interior_fraction: float | None = None
+    warnings: tuple[str, ...] = ()
+
+
+def _angles(phi1, idx) -> str:
+    return ", ".join(f"{i} (φ1 = {np.degrees(phi1[i]):.3f}°)" for i in idx)
+
+
+def report(run: GearRun) -> Report:
+    """The :class:`Report` of a run."""
+    eng = run.engagement
+    warnings = list(eng.warnings) if eng is not None else []
+    missed = eng is not None and eng.missed_handover
+    miss_reason = (
+        "the positions miss the handover of a contact ratio below 1 (see the warnings)"
+        if missed
+        else ""
+    )
+    frac = float(eng.handover.interior_fraction) if eng is not None else None
+    if run.cycle is None:  # unloaded TCA
+        r = run.tca
+        seen = r.te_arcsec[r.has_contact]
+        te_u = float(np.ptp(seen)) if seen.size >= 2 and not missed else None
+        why = miss_reason or ("" if te_u is not None else "fewer than two positions in contact")
+        loaded = "unloaded TCA only (fidelity tca)"
+        return Report(
+            n_positions=int(r.phi1.size),
+            te_pp_unloaded_arcsec=te_u,
+            te_pp_unloaded_reason=why,
+            te_pp_loaded_reason=loaded,
+            contact_ratio_reason=loaded,
+            p_max_reason=loaded,
+            interior_fraction=frac,
+            warnings=tuple(warnings),
+        )
+    c = run.cycle
+    h = c.headline()
+    n = h.n_positions
+    te_u, te_u_why = (
+        h.te_pp_unloaded_arcsec,
+        "" if h.te_pp_unloaded_arcsec is not None else ("fewer than two positions in contact"),
+    )
+    te_l, te_l_why = h.te_pp_loaded_arcsec, h.te_pp_reason
+    cr, cr_why = h.contact_ratio_loaded, ""
+    if missed:
+        te_u, te_u_why = None, miss_reason
+        te_l, te_l_why = None, miss_reason
+        cr, cr_why = None, miss_reason
+    lost_before = set(eng.lost) if eng is not None else set()
+    lost = [e for e in h.excluded if e.status == "lost" and e.index not in lost_before]
+    if lost:
+        where = _angles(c.phi1, [e.index for e in lost])
+        warnings.append(
+            f"no load carried at {len(lost)} of {n} positions: {where} ({lost[0].reason}); "
+            "left out of the TE peak-to-peak"
+        )
+    degen = [e for e in h.excluded if e.status == "degenerate"]
+    if run.fidelity == "fe":
+        bad = [(q, i) for i, p in enumerate(c.positions) for q in p.pairs if q.in_contact]
+        bad = [(q, i) for q, i in bad if not q.resolved]
+        if bad:
+            cells = sorted({float(np.min(cc.cell_mm)) for p in c.positions for cc in p.cells})
+            size = f"{cells[0]:.3g}" + (f"-{cells[-1]:.3g}" if cells[-1] > cells[0] else "")
+            widths = [2.0 * q.semi_minor_mm for q, _ in bad if q.semi_minor_mm > 0]
+            patch = (
+                f"the loaded patch (2b = {min(widths):.3g}-{max(widths):.3g} mm"
+                if widths
+                else "the loaded patch (narrower than one cell"
+            )
+            at = len({i for _, i in bad})
+            warnings.append(
+                f"fe: the contact cells ({size} mm) are wider than {patch}) at {at} of {n} "
+                "positions: the pressures and the TE there are cell averages, not the "
+                "contact's; run --fidelity hybrid (it resolves the patch at every level)"
+            )
+    if degen:
+        where = (
+            f"all {n} positions"
+            if len(degen) == n
+            else f"{len(degen)} of {n} positions: {_angles(c.phi1, [e.index for e in degen])}"
+        )
+        warnings.append(
+            f"degenerate (a loaded patch the cells do not resolve) at {where}; left out of the "
+            "TE peak-to-peak and p_max (reasons in summary.json: cycle.excluded_positions)"
+        )
+    if h.excluded and te_l is not None:
+        warnings.append(
+            f"loaded TE peak-to-peak over {h.te_pp_positions_used} of {n} positions (the others "
+            "are left out, above)"
+        )
+    if te_l is None and not missed:
+        warnings.append(f"loaded TE peak-to-peak not reported: {te_l_why}")
+    if h.p_max_MPa is None:
+        warnings.append(f"p_max not reported: {h.p_max_reason}")
+    return Report(
+        n_positions=n,
+        te_pp_unloaded_arcsec=te_u,
+        te_pp_unloaded_reason=te_u_why,
+        te_pp_loaded_arcsec=te_l,
+        te_pp_loaded_reason=te_l_why,
+        positions_used=h.te_pp_positions_used,
+        excluded=h.excluded,
+        contact_ratio_loaded=cr,
+        contact_ratio_reason=cr_why,
+        p_max_MPa=h.p_max_MPa,
+        p_max_reason=h.p_max_reason,
+        p_max_position=h.p_max_position,
+        p_max_pair=h.p_max_pair,
+        p_max_edge_MPa=h.p_max_edge_MPa,
+        p_max_edge_position=h.p_max_edge_position,
+        p_max_edge_pair=h.p_max_edge_pair,
+        p_max_edge_edges=h.p_max_edge_edges,
+        edge_positions=h.edge_positions,
+        interior_fraction=frac,
+        warnings=tuple(warnings),
     )

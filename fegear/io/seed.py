@@ -41,7 +41,7 @@ dA2_mm = 0.0
 dgamma_deg = 0.0
 
 [analysis]
-fidelity = "fe"
+fidelity = "hybrid"
 level = 0
 n_positions = 25
 
@@ -52,5 +52,5 @@ nu = 0.3
 
 
 def seed_case() -> GearCase:
-    """The seed face-gear case (nominal assembly, fe level 0, 25 positions)."""
+    """The seed face-gear case (nominal assembly, hybrid level 0, 25 positions)."""
     return parse_gear_case(tomllib.loads(SEED_CASE_TOML), source="<built-in seed case>")

@@ -41,10 +41,11 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
-from fegear.ltca.grid import PairCells, missing_pairs, pair_cells, take_cells
+from fegear.ltca.grid import PairCells, edge_names, missing_pairs, pair_cells, take_cells
 from fegear.ltca.hybrid import hybrid_compliance, hybrid_displacement, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
@@ -52,7 +53,13 @@ from fegear.ltca.model import (
     cell_load_operators,
     member_compliance,
 )
-from fegear.ltca.results import LoadedPosition, PairLoad
+from fegear.ltca.results import (
+    DEGENERATE_SHARE,
+    MIN_CELLS_ACROSS,
+    LoadedPosition,
+    PairLoad,
+    edge_reach_mm,
+)
 from fegear.ltca.warm import active_guess, footprint, likely_cells, ring_cells
 from fegear.ltca.zone import ContactZone, contact_zone, left_out_pairs
 from fegear.mesh.sector import FINE, sector_mesh
@@ -319,7 +326,47 @@ def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
         solution=empty,
         g_max_mm=0.0,
         warnings=(reason,),
+        status="lost",
+        status_reason=reason,
+        unloaded_contact=bool(pos.has_contact),
     )
+
+
+def _edge_split(c: PairCells, act, p, semi_minor: float, b1, b2):
+    """``(edges, p_interior, p_edge)`` of one loaded pair: the boundaries its active cells touch
+    (named), the largest pressure of the active cells farther than
+    :func:`~fegear.ltca.results.edge_reach_mm` from every active boundary cell (None if none),
+    and the largest within that reach (None for an interior contact). Distances in the pair's
+    flank-plane coordinates ``c.local``."""
+    mask = c.boundary_edges if c.boundary_edges is not None else c.boundary.astype(np.uint8)
+    on_edge = act & (mask != 0)
+    if not on_edge.any():
+        return (), float(p[act].max()), None
+    reach = edge_reach_mm(c.cell_mm, semi_minor)
+    d = cKDTree(c.local[on_edge]).query(c.local)[0]
+    far = act & (d > reach)
+    near = act & ~far
+    p_int = float(p[far].max()) if far.any() else None
+    return edge_names(mask[on_edge], b1, b2), p_int, float(p[near].max())
+
+
+def _position_status(pos, loads, cells) -> tuple[str, str]:
+    """``("ok", "")`` or ``("degenerate", why)``: a pair carrying at least
+    :data:`~fegear.ltca.results.DEGENERATE_SHARE` of the torque whose patch the cells do not
+    resolve (:data:`~fegear.ltca.results.MIN_CELLS_ACROSS`)."""
+    bad = []
+    for q, c in zip(loads, cells, strict=True):
+        if q.in_contact and not q.resolved and q.load_share >= DEGENERATE_SHARE:
+            size = float(c.cell_mm.min())
+            bad.append(
+                f"pair ({q.k}, {q.j}) carries {100 * q.load_share:.0f} % of the torque on "
+                f"{q.n_active} cell{'s' if q.n_active != 1 else ''} of {size:.3g} mm, "
+                f"{q.cells_across:.1f} across its patch (2b = {2 * q.semi_minor_mm:.3g} mm; "
+                f"at least {MIN_CELLS_ACROSS:g} needed)"
+            )
+    if bad:
+        return "degenerate", f"phi1 = {np.degrees(pos.phi1):.3f} deg: " + "; ".join(bad)
+    return "ok", ""
 
 
 def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
@@ -502,6 +549,7 @@ def solve_position(
     # Per-pair results.
     loads, pressures = [], []
     start = 0
+    b1, b2 = tca.fm1.bounds, tca.fm2.bounds
     for c in cells:
         F = sol.force[start : start + c.n]
         act = sol.active[start : start + c.n]
@@ -509,18 +557,22 @@ def solve_position(
         p = F / c.area
         pressures.append(p)
         f_tot = float(F.sum())
+        edges, p_int, p_edge, across = (), None, None, 0.0
         if f_tot > 0.0:
             pm = measure_patch(c.local, F, c.area)
             centroid = (F @ c.centers) / f_tot
             semi = (pm.semi_major, pm.semi_minor)
-            if 2.0 * pm.semi_minor < 4.0 * float(c.cell_mm.min()):
+            across = 2.0 * pm.semi_minor / float(c.cell_mm.min())
+            if across < 4.0:
                 msg = (
                     f"pair ({c.k}, {c.j}) at phi1 = {np.degrees(pos.phi1):.3f} deg: contact "
-                    f"grid too coarse for the patch: "
-                    f"{2 * pm.semi_minor / c.cell_mm.min():.1f} cells across the minor axis"
+                    f"grid too coarse for the patch: {across:.1f} cells across the minor axis"
                 )
                 warnings.append(msg)
             p_peak = pm.p_peak
+            edges, p_int, p_edge = _edge_split(c, act, p, pm.semi_minor, b1, b2)
+            if across < MIN_CELLS_ACROSS:
+                p_int = None  # a cell average over an unresolved patch is not a pressure
         else:
             centroid, semi, p_peak = np.zeros(3), (0.0, 0.0), 0.0
         loads.append(
@@ -537,8 +589,14 @@ def solve_position(
                 n_active=int(act.sum()),
                 edge_contact=bool(np.any(act & c.boundary)),
                 contact_point=centroid,
+                edges=edges,
+                p_interior_MPa=p_int,
+                p_edge_MPa=p_edge,
+                cells_across=float(across),
+                resolved=bool(across >= MIN_CELLS_ACROSS),
             )
         )
+    status, reason = _position_status(pos, loads, cells)
     left = left_out_pairs(pos, models, sol.theta, warnings)
     te_l = pos.te_arcsec - sol.theta / ARCSEC
     return LoadedPosition(
@@ -553,4 +611,6 @@ def solve_position(
         g_max_mm=g_max,
         warnings=tuple(warnings),
         left_out=left,
+        status=status,
+        status_reason=reason,
     )

@@ -46,7 +46,7 @@ from fegear.ltca.zone import ContactZone
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 
-__all__ = ["run_ltca", "chunks", "grown_zone"]
+__all__ = ["run_ltca", "chunks", "cycle_tca", "grown_zone"]
 
 log = logging.getLogger(__name__)
 
@@ -84,15 +84,31 @@ def _solve_chunk(r: range, job: dict[str, object] | None = None) -> list[LoadedP
 
 
 def _worker_init(threads: int) -> None:
-    """In a forked worker: its share of the cores, for the threaded half-space evaluation and for
-    BLAS. OpenBLAS threads left at the core count in every worker (they spin while waiting for
-    work) made the two workers of the seed face gear 1.6-3x slower, erratically (measured)."""
+    """In a forked worker: its share of the cores for the threaded half-space evaluation
+    (row blocks, each computed whole by one thread: the same numbers with any thread count), and
+    one BLAS thread (:func:`_one_blas_thread`)."""
+    os.environ["FEGEAR_THREADS"] = str(threads)
+    _one_blas_thread()  # for the worker's lifetime (never restored)
+
+
+def _one_blas_thread():
+    """Limit OpenBLAS (numpy's and SciPy's BLAS) to one thread in this process; returns the
+    limiter (a context manager that restores the previous limits).
+
+    The positions' dense algebra (Cholesky of the active compliance block, products) runs on
+    one BLAS thread whatever the worker count, so that ``--workers 1`` and ``--workers N`` do the
+    same arithmetic: with the BLAS thread count following the worker count (2 threads in one
+    process, 1 in each of two workers) the FZG pair at ``hybrid`` level 0 differed by 9e-6″ in
+    the loaded TE and 1.4e-7 in the shares (the contact problem of fine cells is ill-conditioned
+    and amplifies the round-off of a different summation order); with one thread the two runs
+    are bitwise equal (measured, and ``tests/test_reliability.py``). One thread is also faster
+    here: OpenBLAS threads left spinning next to the half-space threads made the same cycle
+    6.1 s in one process against 3.0 s with one BLAS thread (2 cores, measured), and in every
+    worker 1.6-3x slower, erratically. MKL and its OpenMP runtime (used by the operators before
+    the positions) are not touched."""
     from threadpoolctl import ThreadpoolController
 
-    os.environ["FEGEAR_THREADS"] = str(threads)
-    # OpenBLAS only (numpy's and SciPy's BLAS): MKL and its OpenMP runtime, used by the parent
-    # for the operators, are not touched in a forked child. Held for the worker's lifetime.
-    ThreadpoolController().select(internal_api="openblas").limit(limits=threads)
+    return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
 
 
 def _workers(requested: int | None, n_chunks: int) -> int:
@@ -119,7 +135,8 @@ def _solve_all(job: dict[str, object], parts: list[range], workers: int, progres
     if workers == 1:
         finished = itertools.count(1)
         done = SimpleNamespace(put=lambda _i: progress and progress(next(finished), n))
-        return [p for r in parts for p in _solve_chunk(r, {**job, "done": done})]
+        with _one_blas_thread():
+            return [p for r in parts for p in _solve_chunk(r, {**job, "done": done})]
     ctx = multiprocessing.get_context("fork")
     done = ctx.SimpleQueue()
     _JOB.clear()
@@ -146,6 +163,25 @@ def _solve_all(job: dict[str, object], parts: list[range], workers: int, progres
         ) from exc
     finally:
         _JOB.clear()
+
+
+def cycle_tca(pinion, gear, assembly, options: LTCAOptions, phi1: np.ndarray | None = None):
+    """The TCA of the loaded cycle's positions (:func:`fegear.tca.cached.cached_tca`, from the
+    cache when the pair was analysed before): ``(tca, positions, cache_hit)``. ``phi1``: pinion
+    angles (rad), default ``n_positions`` over one cycle ``[−π/N1, π/N1)``. What
+    :func:`run_ltca` solves; a caller that checks the positions first
+    (:func:`fegear.io.gear_run.check_engagement`) gets the same ones."""
+    tca_opt = TCAOptions(
+        n_positions=options.n_positions,
+        separation_grid=options.tca_grid,
+        E_MPa=options.E_MPa,
+        nu=options.nu,
+    )
+    if phi1 is None:
+        n = options.n_positions
+        phi1 = -np.pi / assembly.n1 + 2 * np.pi / assembly.n1 * np.arange(n) / n
+    phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
+    return cached_tca(pinion, gear, assembly, tca_opt, phi1)
 
 
 def run_ltca(
@@ -184,14 +220,8 @@ def run_ltca(
     opt = options or LTCAOptions()
     seconds: dict[str, float] = {}
     t0 = time.perf_counter()
-    tca_opt = TCAOptions(
-        n_positions=opt.n_positions, separation_grid=opt.tca_grid, E_MPa=opt.E_MPa, nu=opt.nu
-    )
-    if phi1 is None:
-        n = opt.n_positions
-        phi1 = -np.pi / assembly.n1 + 2 * np.pi / assembly.n1 * np.arange(n) / n
-    phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
-    tca, tca_pos, _ = cached_tca(pinion, gear, assembly, tca_opt, phi1)
+    tca, tca_pos, _ = cycle_tca(pinion, gear, assembly, opt, phi1)
+    phi1 = np.array([p.phi1 for p in tca_pos], dtype=float)
     asm = tca.asm
     seconds["tca"] = time.perf_counter() - t0
     if models is None:

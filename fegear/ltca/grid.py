@@ -28,10 +28,33 @@ from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
 
-__all__ = ["PairCells", "missing_pairs", "near_cells", "pair_cells", "take_cells"]
+__all__ = [
+    "EDGE_TAGS",
+    "PairCells",
+    "edge_label",
+    "edge_names",
+    "missing_pairs",
+    "near_cells",
+    "pair_cells",
+    "take_cells",
+    "tca_edge_names",
+]
 
 Array = NDArray[np.float64]
 _GAUSS2 = np.array([-1.0, 1.0]) / math.sqrt(3.0)
+#: The working-flank boundaries a contact cell can touch, ``(member, boundary)``, in the bit order
+#: of :attr:`PairCells.boundary_edges`: ``root`` is the fillet limit (``u_fillet``), ``tip`` the
+#: tip (``u_tip``), ``v_start`` / ``v_end`` the face ends (:func:`edge_names` names them).
+EDGE_TAGS = (
+    ("pinion", "root"),
+    ("pinion", "tip"),
+    ("pinion", "v_start"),
+    ("pinion", "v_end"),
+    ("gear", "root"),
+    ("gear", "tip"),
+    ("gear", "v_start"),
+    ("gear", "v_end"),
+)
 #: Grid points evaluated at most, in units of ``max_cells`` (see :func:`pair_cells`).
 _PRECAP = 16
 
@@ -67,6 +90,9 @@ class PairCells:
         ``(2,)`` mm, cell sizes along the cell axes ``ξ`` and ``η``.
     boundary
         ``(n,)`` bool, the cell touches a boundary of the working flank of either member.
+    boundary_edges
+        ``(n,)`` uint8, which boundaries it touches: bit ``i`` set for :data:`EDGE_TAGS` ``[i]``
+        (``boundary == (boundary_edges != 0)``; None for cells made without it).
     angle
         rad, the cell axes ``ξ, η`` are the ``u, v`` arc-length directions turned by ``angle``.
     origin
@@ -89,10 +115,58 @@ class PairCells:
     boundary: NDArray[np.bool_]
     angle: float = 0.0
     origin: Array | None = None
+    boundary_edges: NDArray[np.uint8] | None = None
 
     @property
     def n(self) -> int:
         return int(self.gap.size)
+
+
+def edge_label(member: str, tag: str, bounds) -> str:
+    """Plain name of a working-flank boundary: ``member`` (``"pinion"``/``"gear"``), ``tag``
+    (``"root"``, ``"tip"``, ``"v_start"``, ``"v_end"``, as in the TCA's edge strings) and the
+    member's flank ``bounds`` (:class:`~fegear.geometry.surface.FlankBoundaries`, whose
+    ``v_name`` says what the face ends are: toe/heel of a bevel, inner/outer end of a face gear,
+    the ends −z/+z of a cylindrical gear)."""
+    if tag == "tip":
+        return f"{member} tip"
+    if tag == "root":
+        return f"{member} fillet limit (root end of the working flank)"
+    v = (getattr(bounds, "v_name", "") or "").lower()
+    first = tag == "v_start"
+    if "toe" in v:
+        end = "toe" if first else "heel"
+    elif v.startswith("radius"):
+        end = "inner end" if first else "outer end"
+    else:
+        end = "face end −z" if first else "face end +z"
+    return f"{member} {end}"
+
+
+def edge_names(mask: int | NDArray[np.uint8], bounds1, bounds2) -> tuple[str, ...]:
+    """Names of the boundaries in an :attr:`PairCells.boundary_edges` bit mask (or the OR of
+    several), in :data:`EDGE_TAGS` order; ``bounds1``/``bounds2`` the pinion's and the gear's
+    flank bounds (:func:`edge_label`)."""
+    m = (
+        int(np.bitwise_or.reduce(np.atleast_1d(np.asarray(mask, dtype=np.uint8))))
+        if np.size(mask)
+        else 0
+    )
+    out = []
+    for bit, (member, tag) in enumerate(EDGE_TAGS):
+        if m >> bit & 1:
+            out.append(edge_label(member, tag, bounds1 if member == "pinion" else bounds2))
+    return tuple(out)
+
+
+def tca_edge_names(edge: str, bounds1, bounds2) -> tuple[str, ...]:
+    """Names of the boundaries in a TCA edge string (``"pinion:tip,gear:v_start"``,
+    :attr:`fegear.tca.results.PositionResult.edge`)."""
+    out = []
+    for tag in filter(None, edge.split(",")):
+        member, _, where = tag.partition(":")
+        out.append(edge_label(member, where, bounds1 if member == "pinion" else bounds2))
+    return tuple(out)
 
 
 def _separation(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
@@ -293,24 +367,26 @@ def pair_cells(
     edges = np.stack([rx * cu_mm, ry * cv_mm], axis=1)
     local = _patch_coordinates(X[keep], N[keep], edges, np.asarray(pos.points[ip], dtype=float))
     du, dv = cu_mm, cv_mm  # cell sizes along ξ, η (mm)
-    # Cells touching a working-flank boundary of the pinion or the gear.
+    # Cells touching a working-flank boundary of the pinion or the gear, and which one
+    # (EDGE_TAGS: one bit per member and boundary).
     tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
     hu = 0.5 * (abs(A[0, 0]) * du + abs(A[0, 1]) * dv)  # half extent of a cell along u, v
     hv = 0.5 * (abs(A[1, 0]) * du + abs(A[1, 1]) * dv)
-    on_p = (
-        (CU - hu <= b.u_fillet + tu)
-        | (CU + hu >= b.u_tip - tu)
-        | (CV - hv <= b.v_start + tv)
-        | (CV + hv >= b.v_end - tv)
-    )
     b2 = tca.fm2.bounds
     su, sv = 0.01 * (b2.u_tip - b2.u_fillet), 0.01 * (b2.v_end - b2.v_start)
-    on_g = (
-        (guv[..., 0] <= b2.u_fillet + su)
-        | (guv[..., 0] >= b2.u_tip - su)
-        | (guv[..., 1] <= b2.v_start + sv)
-        | (guv[..., 1] >= b2.v_end - sv)
+    touches = (
+        CU - hu <= b.u_fillet + tu,
+        CU + hu >= b.u_tip - tu,
+        CV - hv <= b.v_start + tv,
+        CV + hv >= b.v_end - tv,
+        guv[..., 0] <= b2.u_fillet + su,
+        guv[..., 0] >= b2.u_tip - su,
+        guv[..., 1] <= b2.v_start + sv,
+        guv[..., 1] >= b2.v_end - sv,
     )
+    mask = np.zeros(CU.shape, dtype=np.uint8)
+    for bit, t in enumerate(touches):
+        mask |= (t & inside).astype(np.uint8) << np.uint8(bit)
     return PairCells(
         k=int(g.k),
         j=int(g.j),
@@ -325,8 +401,9 @@ def pair_cells(
         edges=edges,
         cell_mm=np.array([du, dv]),
         angle=float(angle),
-        boundary=(on_p | on_g)[keep],
+        boundary=mask[keep] != 0,
         origin=np.asarray(pos.points[ip], dtype=float),
+        boundary_edges=mask[keep],
     )
 
 
@@ -347,6 +424,7 @@ def take_cells(cells: PairCells, index: NDArray[np.intp]) -> PairCells:
         local=local,
         edges=cells.edges[index],
         boundary=cells.boundary[index],
+        boundary_edges=None if cells.boundary_edges is None else cells.boundary_edges[index],
     )
 
 

@@ -39,7 +39,7 @@ from scipy.optimize import brentq
 from fegear.contact import ContactSolution
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
-from fegear.ltca.grid import _separation, pair_cells
+from fegear.ltca.grid import _separation, pair_cells, tca_edge_names
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
@@ -49,6 +49,7 @@ __all__ = ["PairLaw", "pair_laws", "solve_position_hertz"]
 
 log = logging.getLogger(__name__)
 _E_STAR_STEEL = 206000.0 / (2.0 * (1.0 - 0.3**2))
+_EPS = float(np.finfo(float).eps)
 
 
 class PairLaw:
@@ -76,7 +77,9 @@ class PairLaw:
         hi = 1.0
         while self.approach(hi) < delta:
             hi *= 4.0
-        return brentq(lambda f: self.approach(f) - delta, 0.0, hi, xtol=1e-14 * hi, rtol=1e-13)
+        # relative tolerance: the force of a tiny approach is tiny (an absolute 1e-14 hi was
+        # a visible part of it at 1e-6 N·m)
+        return brentq(lambda f: self.approach(f) - delta, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS)
 
 
 def _hessian(tca: TCA, pos: PositionResult, i: int, step_mm: float):
@@ -233,11 +236,14 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
     hi = max(1e-9, min(b / h for (_, _, _, b, h, _) in laws) + 1e-7)
     while residual(hi) < 0.0:
         hi *= 2.0
-    theta = brentq(residual, 0.0, hi, xtol=1e-16, rtol=1e-14)
+    # relative tolerance only: an absolute one (1e-16 rad, once) is a large part of the lag at
+    # a tiny torque (1e-6 N·m on FZG: lag ~1e-10 rad, the shares summed to 1 + 6.9e-6)
+    theta = brentq(residual, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS)
     F = forces(theta)
     eq = abs(hvec @ F - torque2_Nmm) / torque2_Nmm
     loads = []
     E_star = effective_modulus(E, nu, E, nu)
+    b1, b2 = tca.fm1.bounds, tca.fm2.bounds
     for (k, j, i, _b, h, law), f in zip(laws, F, strict=True):
         if f > 0.0 and law.kind == "point":
             hp = law.law.point(f)
@@ -262,6 +268,9 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
                 n_active=0,
                 edge_contact=bool(pos.edge[i]) and bool(f > 0.0),
                 contact_point=pos.points[i].copy(),
+                edges=tca_edge_names(pos.edge[i], b1, b2) if f > 0.0 else (),
+                p_interior_MPa=float(p0) if f > 0.0 and not pos.edge[i] else None,
+                p_edge_MPa=float(p0) if f > 0.0 and pos.edge[i] else None,
             )
         )
     sol = ContactSolution(

@@ -7,6 +7,7 @@ driving sense); the loaded TE is the unloaded TE minus that lag.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,9 +17,44 @@ from fegear.contact import ContactSolution
 from fegear.ltca.grid import PairCells
 from fegear.ltca.zone import ContactZone
 
-__all__ = ["PairLoad", "LoadedPosition", "LoadedCycle"]
+__all__ = [
+    "DEGENERATE_SHARE",
+    "EDGE_REACH_CELLS",
+    "MIN_CELLS_ACROSS",
+    "CycleHeadline",
+    "Excluded",
+    "LoadedCycle",
+    "LoadedPosition",
+    "PairLoad",
+    "edge_reach_mm",
+]
 
 Array = NDArray[np.float64]
+
+#: A patch is resolved when its minor axis spans at least this many contact cells. On fewer the
+#: cell pressures are averages over cells wider than the patch and the patch compliance is the
+#: cell's, not the contact's: the issue's FZG case with 0.5 mm axis errors had pairs on a single
+#: 2 mm cell reading 220-950 MPa next to positions at 10-15 GPa, and the loaded TE jumped
+#: 130-200″ there; ``fe`` level 0 on FZG has 0.2 cells across (126-160 MPa where line Hertz says
+#: about 1100 MPa).
+MIN_CELLS_ACROSS = 2.0
+#: A position is degenerate when a pair carrying at least this share of the torque is not
+#: resolved (a pair below it is an edge contact entering or leaving, whose grid the ``hybrid``
+#: refinement leaves alone: :data:`fegear.ltca.hybrid.MIN_REFINE_SHARE`).
+DEGENERATE_SHARE = 0.01
+#: Cells within ``EDGE_REACH_CELLS`` cell sizes (or two patch semi-minor axes, whichever is
+#: larger: :func:`edge_reach_mm`) of an active cell on a flank boundary carry the edge's
+#: singular pressure. Measured on the spiral bevel at ``hybrid`` level 0 (gear-tip edge pairs):
+#: the cells next to the edge cells read 1556-1825 MPa where the interior pairs of the same
+#: positions read 1285-1403 MPa and their Hertz value is 1361 MPa; beyond two cell sizes
+#: 1077-1341 MPa.
+EDGE_REACH_CELLS = 2.0
+
+
+def edge_reach_mm(cell_mm: Array, semi_minor_mm: float) -> float:
+    """Distance (mm) from the edge cells within which the pressure is the edge's (see
+    :data:`EDGE_REACH_CELLS`): ``max(2 max(cell sizes), 2 b)``."""
+    return max(EDGE_REACH_CELLS * float(np.max(cell_mm)), 2.0 * float(semi_minor_mm))
 
 
 @dataclass(frozen=True)
@@ -47,6 +83,23 @@ class PairLoad:
         An active cell touches a boundary of a working flank.
     contact_point
         ``(3,)`` mm, force centroid in the fixed frame (zeros if no load).
+    edges
+        The boundaries its active cells touch, named (:func:`fegear.ltca.grid.edge_names`:
+        ``"pinion tip"``, ``"gear toe"``, ...); empty for an interior contact.
+    p_interior_MPa
+        Largest pressure away from the edges: over the active cells farther than
+        :func:`edge_reach_mm` from every active cell on a boundary (all active cells of an
+        interior contact); None when no such cell exists (the whole patch is an edge contact)
+        or the patch is not resolved (``resolved`` False: its cell pressures are cell averages
+        of an unresolved patch, not a pressure).
+    p_edge_MPa
+        Largest pressure within that reach of the edges (singular, grid-dependent); None for an
+        interior contact.
+    cells_across
+        Contact cells across the patch's minor axis (``2 b`` over the cell width; 0 for a patch
+        on one cell; ``inf`` for the closed-form ``hertz`` fidelity).
+    resolved
+        ``cells_across >= MIN_CELLS_ACROSS``: the grid resolves the patch.
     """
 
     k: int
@@ -61,6 +114,11 @@ class PairLoad:
     n_active: int
     edge_contact: bool
     contact_point: Array
+    edges: tuple[str, ...] = ()
+    p_interior_MPa: float | None = None
+    p_edge_MPa: float | None = None
+    cells_across: float = math.inf
+    resolved: bool = True
 
     @property
     def in_contact(self) -> bool:
@@ -94,6 +152,17 @@ class LoadedPosition:
     left_out
         Pairs ``(k, j)`` the lag closes that lie outside the modelled teeth (the cycle grows its
         zone to hold them: :func:`fegear.ltca.cycle.grown_zone`).
+    status
+        ``"ok"``; ``"lost"``: no pair carries load here (the flanks do not meet, or their only
+        contact is an edge the cells do not represent); ``"degenerate"``: a pair carrying at
+        least :data:`DEGENERATE_SHARE` of the torque is not resolved (on one cell, or a grid
+        coarser than its patch). The cycle's headline TE peak-to-peak leaves out the positions
+        that are not ``"ok"`` (:meth:`LoadedCycle.headline`).
+    status_reason
+        Why, in words ("" when ok).
+    unloaded_contact
+        The unloaded TCA found contact at this position (False: its unloaded TE is a
+        placeholder 0, not a TE).
     """
 
     phi1: float
@@ -107,6 +176,9 @@ class LoadedPosition:
     g_max_mm: float
     warnings: tuple[str, ...]
     left_out: tuple[tuple[int, int], ...] = ()
+    status: str = "ok"
+    status_reason: str = ""
+    unloaded_contact: bool = True
 
     @property
     def n_pairs_in_contact(self) -> int:
@@ -115,6 +187,101 @@ class LoadedPosition:
     @property
     def p_max_MPa(self) -> float:
         return max((p.p_max_MPa for p in self.pairs), default=0.0)
+
+
+@dataclass(frozen=True)
+class Excluded:
+    """A position left out of the cycle's headline TE peak-to-peak.
+
+    Attributes
+    ----------
+    index
+        Position index.
+    phi1
+        Pinion angle (rad).
+    status
+        ``"lost"`` or ``"degenerate"`` (:attr:`LoadedPosition.status`).
+    reason
+        Why, in words.
+    """
+
+    index: int
+    phi1: float
+    status: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class CycleHeadline:
+    """The cycle's headline numbers, each meaning what it says (DESIGN §10).
+
+    A value is None when nothing physical can be reported, with the reason next to it.
+
+    Attributes
+    ----------
+    n_positions
+        Positions of the cycle.
+    te_pp_unloaded_arcsec
+        Unloaded TE peak-to-peak over the positions where the TCA found contact (None if fewer
+        than two).
+    te_pp_loaded_arcsec
+        Loaded TE peak-to-peak over the usable positions (status ``"ok"``), None if fewer than
+        two; ``te_pp_positions_used`` of them, ``te_pp_reason`` why None ("" otherwise).
+    excluded
+        The positions left out of it, with their reasons.
+    contact_ratio_loaded
+        Mean number of pairs carrying load over all positions.
+    p_max_MPa
+        Largest pressure away from the flank edges (:attr:`PairLoad.p_interior_MPa`) over the
+        usable positions, at ``p_max_position`` on pair ``p_max_pair``; None with
+        ``p_max_reason`` when no loaded cell is away from an edge on a resolved patch.
+    p_max_edge_MPa
+        Largest pressure at a flank edge (singular, grid-dependent) over the usable positions,
+        at ``p_max_edge_position`` on pair ``p_max_edge_pair``, where it touches
+        ``p_max_edge_edges``; None when no usable position has an edge contact.
+    edge_positions
+        Usable positions with a loaded pair at an edge.
+    """
+
+    n_positions: int
+    te_pp_unloaded_arcsec: float | None
+    te_pp_loaded_arcsec: float | None
+    te_pp_positions_used: int
+    te_pp_reason: str
+    excluded: tuple[Excluded, ...]
+    contact_ratio_loaded: float
+    p_max_MPa: float | None
+    p_max_reason: str
+    p_max_position: int | None
+    p_max_pair: tuple[int, int] | None
+    p_max_edge_MPa: float | None
+    p_max_edge_position: int | None
+    p_max_edge_pair: tuple[int, int] | None
+    p_max_edge_edges: tuple[str, ...]
+    edge_positions: tuple[int, ...]
+
+
+def _none_usable(excluded: tuple[Excluded, ...]) -> str:
+    """Why no position is usable, counted by status (the reasons are per position)."""
+    counts = {s: sum(e.status == s for e in excluded) for s in ("degenerate", "lost")}
+    parts = [f"{v} {k}" for k, v in counts.items() if v]
+    return f"no usable position ({', '.join(parts)}: see the excluded positions)"
+
+
+def _why_no_p_max(positions: tuple[LoadedPosition, ...], used: list[int]) -> str:
+    """The reason for a null headline p_max (no usable pressure away from the edges)."""
+    if not used:
+        return _none_usable(
+            tuple(Excluded(i, p.phi1, p.status, p.status_reason) for i, p in enumerate(positions))
+        )
+    resolved = [q for i in used for q in positions[i].pairs if q.in_contact and q.resolved]
+    if resolved:  # none of them has a cell away from the edges
+        edges = sorted({e for q in resolved for e in q.edges})
+        return (
+            "every loaded contact is at a flank edge (" + ", ".join(edges) + "): its pressure "
+            "is singular and grid-dependent, see p_max_edge_MPa"
+        )
+    return "no loaded patch away from the edges is resolved by the contact cells"
 
 
 @dataclass(frozen=True)
@@ -164,10 +331,13 @@ class LoadedCycle:
 
     @property
     def te_pp_unloaded_arcsec(self) -> float:
+        """Raw: over every position (:meth:`headline` for the one to report)."""
         return float(np.ptp(self.te_unloaded_arcsec)) if self.phi1.size else 0.0
 
     @property
     def te_pp_loaded_arcsec(self) -> float:
+        """Raw: over every position, lost and degenerate ones included (:meth:`headline`
+        leaves them out)."""
         return float(np.ptp(self.te_loaded_arcsec)) if self.phi1.size else 0.0
 
     @property
@@ -177,4 +347,58 @@ class LoadedCycle:
 
     @property
     def p_max_MPa(self) -> float:
+        """Raw: the largest cell pressure anywhere, edges included (:meth:`headline`)."""
         return max((p.p_max_MPa for p in self.positions), default=0.0)
+
+    def headline(self) -> CycleHeadline:
+        """The headline numbers (:class:`CycleHeadline`): TE peak-to-peak over the usable
+        positions only, p_max away from the edges, the edge value beside it with the edge
+        named."""
+        pos = self.positions
+        used = [i for i, p in enumerate(pos) if p.status == "ok"]
+        excluded = tuple(
+            Excluded(i, float(p.phi1), p.status, p.status_reason)
+            for i, p in enumerate(pos)
+            if p.status != "ok"
+        )
+        te_l = None
+        reason = ""
+        if len(used) >= 2:
+            te_l = float(np.ptp(self.te_loaded_arcsec[used]))
+        elif not used:
+            reason = _none_usable(excluded)
+        else:
+            reason = f"only one usable position (of {len(pos)})"
+        seen = [i for i, p in enumerate(pos) if p.unloaded_contact]
+        te_u = float(np.ptp(self.te_unloaded_arcsec[seen])) if len(seen) >= 2 else None
+        best = edge = None
+        edge_positions = []
+        for i in used:
+            for q in pos[i].pairs:
+                if not q.in_contact:
+                    continue
+                if q.p_interior_MPa is not None and (best is None or q.p_interior_MPa > best[0]):
+                    best = (q.p_interior_MPa, i, (q.k, q.j))
+                if q.p_edge_MPa is not None:
+                    if not edge_positions or edge_positions[-1] != i:
+                        edge_positions.append(i)
+                    if edge is None or q.p_edge_MPa > edge[0]:
+                        edge = (q.p_edge_MPa, i, (q.k, q.j), q.edges)
+        return CycleHeadline(
+            n_positions=len(pos),
+            te_pp_unloaded_arcsec=te_u,
+            te_pp_loaded_arcsec=te_l,
+            te_pp_positions_used=len(used),
+            te_pp_reason=reason,
+            excluded=excluded,
+            contact_ratio_loaded=self.contact_ratio_loaded,
+            p_max_MPa=None if best is None else float(best[0]),
+            p_max_reason="" if best is not None else _why_no_p_max(pos, used),
+            p_max_position=None if best is None else best[1],
+            p_max_pair=None if best is None else best[2],
+            p_max_edge_MPa=None if edge is None else float(edge[0]),
+            p_max_edge_position=None if edge is None else edge[1],
+            p_max_edge_pair=None if edge is None else edge[2],
+            p_max_edge_edges=() if edge is None else tuple(edge[3]),
+            edge_positions=tuple(edge_positions),
+        )
