@@ -353,6 +353,9 @@ def _sweep(args: argparse.Namespace) -> int:
     )
     if not args.quiet:
         print((res.out / "comparison.md").read_text(encoding="utf-8"), end="")
+    if res.comparison_error:
+        print(f"fegear: failed: {res.comparison_error}", file=sys.stderr)
+        return 1
     return 1 if res.n_failed else 0
 
 

@@ -17,10 +17,16 @@ Several grid axes make their Cartesian product.
 Robustness (one sweep per output folder at a time; a lock file enforces it on POSIX):
 
 - an item is computed into ``out/.<item>.<id>.tmp/``; its marker ``sweep_item.json`` (inputs
-  fingerprint) is written last, then the folder is renamed into place (atomic on one file
-  system). A folder ``out/<item>/`` is trusted only with a marker whose fingerprint matches the
-  item (case data, fidelity, level, fegear version); otherwise the item is recomputed and the
-  folder replaced.
+  fingerprint, SHA-256 of the item's summary.json) is written last, then the folder is renamed
+  into place (atomic on one file system). A folder ``out/<item>/`` is trusted only with a marker
+  whose fingerprint matches the item (case data, fidelity, level, fegear version) and a
+  summary.json that still has the recorded SHA-256 and parses (:func:`verified_summary`: checked
+  when the sweep starts and again when the comparison reads it); otherwise the item is
+  recomputed and the folder replaced.
+- the comparison's reference item (``--nominal``, else the first item without installation
+  errors, else the first item) is fixed by the items, not by which ones finished: if it has no
+  valid results the comparison is an error (``SweepResult.comparison_error``, exit code 1),
+  never a silent substitute.
 - a re-run skips finished items, recomputes the others and removes leftover ``*.tmp`` folders of
   an interrupted run.
 - an item that fails is reported with its one-line error and does not stop the others.
@@ -33,7 +39,9 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import hashlib
 import itertools
+import json
 import logging
 import math
 import os
@@ -63,6 +71,7 @@ __all__ = [
     "run_sweep",
     "require_dask",
     "is_done",
+    "verified_summary",
     "MARKER",
 ]
 
@@ -176,6 +185,9 @@ class SweepResult:
         The sweep outputs written (sweep.json, comparison.md, te_overlay.png).
     seconds
         Wall time of the sweep.
+    comparison_error
+        Why the comparison could not be made ("" if it was): its reference item has no valid
+        results.
     """
 
     out: Path
@@ -183,6 +195,7 @@ class SweepResult:
     results: dict[str, ItemResult]
     files: tuple[Path, ...] = ()
     seconds: float = 0.0
+    comparison_error: str = ""
 
     @property
     def n_failed(self) -> int:
@@ -400,8 +413,6 @@ def build_items(
 
 
 def _read_marker(folder: Path) -> dict[str, Any] | None:
-    import json
-
     try:
         doc = json.loads((folder / MARKER).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -409,14 +420,45 @@ def _read_marker(folder: Path) -> dict[str, Any] | None:
     return doc if isinstance(doc, dict) else None
 
 
+def _digest(path: Path) -> str | None:
+    """SHA-256 of a file (None if it cannot be read)."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def verified_summary(folder: Path) -> dict[str, Any] | None:
+    """The item's ``summary.json`` document, or None unless it is the one its marker vouches
+    for: the marker (written last) records the SHA-256 of the summary, and the file read now
+    must have it and parse (a summary truncated or edited after the item finished is not
+    trusted)."""
+    m = _read_marker(folder)
+    if m is None or not m.get("summary_sha256"):
+        return None
+    path = folder / "summary.json"
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    if hashlib.sha256(data).hexdigest() != m["summary_sha256"]:
+        return None
+    try:
+        doc = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
 def is_done(folder: Path, item: SweepItem) -> bool:
-    """Whether ``folder`` holds the finished results of ``item`` (marker with its fingerprint
-    and a summary.json)."""
+    """Whether ``folder`` holds the finished, complete results of ``item``: a marker with its
+    fingerprint and a summary.json that is the one the marker vouches for
+    (:func:`verified_summary`)."""
     m = _read_marker(folder)
     return (
         m is not None
         and m.get("fingerprint") == item.fingerprint()
-        and (folder / "summary.json").is_file()
+        and verified_summary(folder) is not None
     )
 
 
@@ -496,6 +538,7 @@ def run_item(
                 "base_case": item.base,
                 "params": item.params,
                 "fingerprint": item.fingerprint(),
+                "summary_sha256": _digest(tmp / "summary.json"),
                 "fegear": __version__,
                 "seconds": seconds,
                 "finished_unix": time.time(),
@@ -626,7 +669,7 @@ def run_sweep(
     FegearError
         The scheduler cannot be reached, or another sweep holds the folder.
     """
-    from fegear.io.sweep_output import write_sweep_json, write_sweep_outputs
+    from fegear.io.sweep_output import comparison_error, write_sweep_json, write_sweep_outputs
 
     items = tuple(items)
     if workers < 1:
@@ -661,7 +704,10 @@ def run_sweep(
                 say(r, len(results), len(items))
                 write_sweep_json(out, items, results, meta)
         files = write_sweep_outputs(out, items, results, meta)
-    return SweepResult(out, items, results, tuple(files), time.perf_counter() - t0)
+        cmp_error = comparison_error(out, items, results, meta)
+    return SweepResult(
+        out, items, results, tuple(files), time.perf_counter() - t0, comparison_error=cmp_error
+    )
 
 
 def _execute(

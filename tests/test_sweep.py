@@ -28,11 +28,13 @@ N_POS = 3
 
 @pytest.fixture(scope="module")
 def fzg3(tmp_path_factory) -> Path:
-    """The FZG case with 3 positions (fast)."""
+    """The FZG case with 3 positions at the ``hertz`` fidelity (fast: milliseconds per position
+    once the sectors are cached; the shipped case runs ``hybrid``)."""
     text = FZG.read_text(encoding="utf-8")
-    assert "n_positions = 9" in text
+    assert "n_positions = 9" in text and '\nfidelity = "hybrid"' in text
     path = tmp_path_factory.mktemp("case") / "fzg3.toml"
-    path.write_text(text.replace("n_positions = 9", f"n_positions = {N_POS}"), "utf-8")
+    text = text.replace("n_positions = 9", f"n_positions = {N_POS}")
+    path.write_text(text.replace('\nfidelity = "hybrid"', '\nfidelity = "hertz"'), "utf-8")
     return path
 
 
@@ -181,9 +183,46 @@ def test_stale_or_foreign_item_folder_is_recomputed(fzg3, tmp_path, capsys):
     # another level: another fingerprint, recomputed
     (out / "fzg_spur" / "summary.json").touch()
     t = (out / "fzg_spur" / "summary.json").stat().st_mtime_ns
-    assert main(["sweep", str(fzg3), "--out", str(out), "--fidelity", "hertz", "-q"]) == 0
+    assert main(["sweep", str(fzg3), "--out", str(out), "--fidelity", "tca", "-q"]) == 0
     assert (out / "fzg_spur" / "summary.json").stat().st_mtime_ns != t
-    assert json.loads((out / "fzg_spur" / "summary.json").read_text())["fidelity"] == "hertz"
+    assert json.loads((out / "fzg_spur" / "summary.json").read_text())["fidelity"] == "tca"
+
+
+def test_truncated_summary_is_not_trusted(fzg3, tmp_path, capsys):
+    """A finished item whose summary.json was cut short afterwards (its marker intact) is not
+    skipped as done: the marker's SHA-256 no longer matches, the item is recomputed (issue 21;
+    it was skipped and the comparison took another item as its reference)."""
+    out = tmp_path / "sweep"
+    argv = ["sweep", str(fzg3), "--out", str(out), "--fidelity", "tca"]
+    assert main([*argv, "-q"]) == 0
+    summary = out / "fzg_spur" / "summary.json"
+    text = summary.read_text()
+    summary.write_text(text[: len(text) // 2])  # truncated, marker left as it was
+    capsys.readouterr()
+    assert main(argv) == 0
+    assert "fzg_spur  done in" in capsys.readouterr().err  # recomputed, not "skipped (done)"
+    assert json.loads(summary.read_text())["case"] == "fzg_spur"
+
+
+def test_missing_reference_item_is_an_error(fzg3, tmp_path, capsys):
+    """The comparison's reference is the item without installation errors whether or not it
+    finished; if its results are missing the comparison is an error (exit 1 naming it), never
+    another item taken silently as the reference (issue 21)."""
+    out = tmp_path / "sweep"
+    argv = ["sweep", str(fzg3), "--grid", "errors.f_sigma_beta_mm=0,0.005", "--out", str(out),
+            "--fidelity", "tca"]  # fmt: skip
+    assert main([*argv, "-q"]) == 0
+    ref = "fzg_spur__f_sigma_beta_mm=0"
+    assert json.loads((out / "sweep.json").read_text())["comparison"]["nominal"] == ref
+    from fegear.io.sweep_output import comparison, key_results, reference_item
+    from fegear.sweep import build_items, verified_summary
+
+    items = build_items([fzg3], ["errors.f_sigma_beta_mm=0,0.005"], fidelity="tca")
+    other = items[1].name
+    keyres = {other: key_results(verified_summary(out / other))}
+    assert reference_item(items, None) == ref  # not the only finished item
+    cmp = comparison(items, keyres)
+    assert cmp["nominal"] == ref and cmp["rows"] == [] and ref in cmp["error"]
 
 
 def test_failing_item_does_not_stop_the_others(fzg3, tmp_path, capsys):
@@ -205,7 +244,12 @@ def test_failing_item_does_not_stop_the_others(fzg3, tmp_path, capsys):
     status = {it["name"]: it["status"] for it in doc["items"]}
     assert status == {"pointed": "failed", "fzg_spur": "done"}
     assert not (out / "pointed").exists() and not list(out.glob(".*.tmp"))
-    assert "pointed | failed: pair (gear tip_radius_mm" in (out / "comparison.md").read_text()
+    assert "pointed** | failed: pair (gear tip_radius_mm" in (out / "comparison.md").read_text()
+    # the reference is the first item without errors, "pointed": it failed, so there is no
+    # comparison, and the sweep says so; fzg_spur is not taken instead (issue 21)
+    assert "fegear: failed: the reference item 'pointed' has no valid results" in err
+    assert doc["comparison"]["nominal"] == "pointed" and doc["comparison"]["rows"] == []
+    assert "Error: the reference item 'pointed'" in (out / "comparison.md").read_text()
 
 
 # --------------------------------------------------------------------------------------------

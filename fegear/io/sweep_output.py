@@ -27,7 +27,6 @@ pattern position − nominal.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -42,6 +41,8 @@ __all__ = [
     "TE_FLOOR_ARCSEC",
     "key_results",
     "comparison",
+    "comparison_error",
+    "reference_item",
     "write_sweep_json",
     "write_sweep_outputs",
 ]
@@ -119,10 +120,10 @@ def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _read_summary(folder: Path) -> dict[str, Any] | None:
-    try:
-        return json.loads((folder / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
+    """The item's summary.json, only if it is the complete one its marker vouches for."""
+    from fegear.sweep import verified_summary
+
+    return verified_summary(folder)
 
 
 def _ratio(a: float | None, b: float | None) -> float | None:
@@ -131,14 +132,16 @@ def _ratio(a: float | None, b: float | None) -> float | None:
     return a / b
 
 
-def _pick_nominal(items: Sequence, done: Mapping[str, dict], nominal: str | None) -> str | None:
+def reference_item(items: Sequence, nominal: str | None) -> str | None:
+    """The comparison's reference item: ``nominal``, else the first item without installation
+    errors, else the first item. It depends on the items only, never on which of them
+    finished (a missing reference is an error, not a reason to take another one)."""
     if nominal is not None:
-        return nominal if nominal in done else None
-    ready = [it for it in items if it.name in done]
-    for it in ready:
+        return nominal
+    for it in items:
         if it.case.errors.is_zero:
             return it.name
-    return ready[0].name if ready else None
+    return items[0].name if items else None
 
 
 def comparison(
@@ -153,19 +156,28 @@ def comparison(
     keyres
         ``{item name: key_results(...)}`` of the finished items.
     nominal
-        The reference item (default: the first finished item without installation errors, else
-        the first finished item).
+        The reference item (default: the first item without installation errors, else the
+        first item; :func:`reference_item`).
 
     Returns
     -------
     dict
         ``{"nominal": name | None, "basis": "loaded" | "unloaded", "rows": [...]}``; a row per
         finished item: ``item``, ``params``, ``te_ratio``, ``te_ratio_unloaded``,
-        ``te_ratio_loaded``, ``pattern_shift_mm``, ``pattern_shift_toward``.
+        ``te_ratio_loaded``, ``pattern_shift_mm``, ``pattern_shift_toward``. When the reference
+        item (:func:`reference_item`) has no valid results: no rows and ``"error"``.
     """
-    nom = _pick_nominal(items, keyres, nominal)
+    nom = reference_item(items, nominal)
     if nom is None:
-        return {"nominal": None, "basis": None, "rows": []}
+        return {"nominal": None, "basis": None, "rows": [], "error": "no items"}
+    if nom not in keyres:
+        return {
+            "nominal": nom,
+            "basis": None,
+            "rows": [],
+            "error": f"the reference item {nom!r} has no valid results (failed, not run, or its "
+            "summary.json is incomplete): no comparison",
+        }
     n = keyres[nom]
     kind = next(it.case.kind for it in items if it.name == nom)
     _, plus, minus = _MEASURE.get(kind, _MEASURE["spur"])
@@ -199,7 +211,7 @@ def comparison(
                 "pattern_shift_toward": toward,
             }
         )
-    return {"nominal": nom, "basis": basis, "rows": rows}
+    return {"nominal": nom, "basis": basis, "rows": rows, "error": None}
 
 
 def _collect(out: Path, items: Sequence, results: Mapping) -> tuple[dict, dict]:
@@ -272,6 +284,10 @@ def _markdown(doc: dict[str, Any]) -> str:
     lines = [
         "# Sweep comparison",
         "",
+    ]
+    if cmp.get("error"):
+        lines += [f"**Error: {cmp['error']}.**", ""]
+    lines += [
         f"Nominal item: `{cmp['nominal']}`. TE ratio = TE peak-to-peak / nominal "
         f"({cmp['basis']} TE). Pattern shift = mean contact position − nominal "
         f"({_measure_text(doc)}).",
@@ -392,3 +408,9 @@ def write_sweep_outputs(
     doc["files"] = [p.name for p in paths] + ["sweep.json"]
     paths.append(write_json(out / "sweep.json", doc))
     return paths
+
+
+def comparison_error(out: Path, items: Sequence, results: Mapping, meta: Mapping[str, Any]) -> str:
+    """Why the comparison of the sweep in ``out`` cannot be made ("" if it can)."""
+    _, _, keyres = _document(Path(out), items, results, meta)
+    return comparison(items, keyres, meta.get("nominal")).get("error") or ""
