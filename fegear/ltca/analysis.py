@@ -335,9 +335,16 @@ def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
 def _edge_split(c: PairCells, act, p, semi_minor: float, b1, b2):
     """``(edges, p_interior, p_edge)`` of one loaded pair: the boundaries its active cells touch
     (named), the largest pressure of the active cells farther than
-    :func:`~fegear.ltca.results.edge_reach_mm` from every active boundary cell (None if none),
-    and the largest within that reach (None for an interior contact). Distances in the pair's
-    flank-plane coordinates ``c.local``."""
+    :func:`~fegear.ltca.results.edge_reach_mm` from every active boundary cell, and the largest
+    within that reach (None for an interior contact). Distances in the pair's flank-plane
+    coordinates ``c.local``.
+
+    The pressure away from the edge is the pair's interior value only where the patch has an
+    interior: at least the pair's mean pressure (force over loaded area; a Hertz patch peaks at
+    1.5 times its mean, a line contact at 1.27 times). Below it, the cells away from the edge are
+    the tail of a patch sitting on the edge, and the value is None: measured on FZG with a
+    0.5 mm axis tilt (corner contacts at a face end), the cells beyond the reach read 94 MPa
+    where the pair's mean pressure is about 3000 MPa and its edge cells 14-17 GPa."""
     mask = c.boundary_edges if c.boundary_edges is not None else c.boundary.astype(np.uint8)
     on_edge = act & (mask != 0)
     if not on_edge.any():
@@ -347,6 +354,9 @@ def _edge_split(c: PairCells, act, p, semi_minor: float, b1, b2):
     far = act & (d > reach)
     near = act & ~far
     p_int = float(p[far].max()) if far.any() else None
+    p_mean = float((p * c.area)[act].sum() / c.area[act].sum())
+    if p_int is not None and p_int < p_mean:
+        p_int = None  # the tail of an edge contact, not an interior
     return edge_names(mask[on_edge], b1, b2), p_int, float(p[near].max())
 
 
