@@ -15,7 +15,15 @@ Fidelities (DESIGN §9) available for gear pairs:
 - ``"tca"``: the rigid, unloaded TCA (:func:`fegear.tca.run_tca`): unloaded TE, contact path,
   unloaded bearing pattern. No FE, no loaded results.
 
-The spiral bevel case files ask for ``"tca"`` (fast); ``fe`` and ``hertz`` run on them too.
+- ``"hybrid"`` (the default of every gear case) and ``"hertz"``: as ``"fe"`` with the compliance
+  of :mod:`fegear.ltca.hybrid` or the per-pair Hertz laws of :mod:`fegear.ltca.hertz_model`.
+
+Before any FE work, :func:`check_engagement` decides every way the contact can fail (issue 21):
+a tip running into the mate's root and no contact at any position are refused
+(:class:`~fegear.errors.InputError` naming the installation-error fields), contact lost at some
+positions and a contact ratio below 1 become warnings. :func:`report` gives the headline numbers
+as they are reported: over the usable positions only, p_max away from the edges, None with a
+reason where nothing physical can be reported.
 """
 
 from __future__ import annotations
@@ -262,11 +270,11 @@ class GearRun:
     assembly
         The assembly with the reference gear phase (the one the analysis used).
     cycle
-        :class:`~fegear.ltca.LoadedCycle` (fidelity ``"fe"``), else None.
+        :class:`~fegear.ltca.LoadedCycle` (loaded fidelities), else None.
     tca
         :class:`~fegear.tca.CycleResult` (fidelity ``"tca"``), else None.
     members
-        The two :class:`MemberField` (fidelity ``"fe"``), else empty.
+        The two :class:`MemberField` (fidelities ``"fe"`` and ``"hybrid"``), else empty.
     seconds
         Wall time per stage.
     engagement
