@@ -130,7 +130,8 @@ def test_spiral_bevel_p_max_is_the_hertz_value_of_its_most_loaded_interior_posit
     assert main(["run", str(BEVEL), "--out", str(out), "-q"]) == 0
     doc = _summary(out)
     c = doc["cycle"]
-    assert doc["fidelity"] == "hybrid" and c["excluded_positions"] == []
+    assert doc["fidelity"] == "hybrid"
+    assert doc["positions"][c["p_max_at"]["position"]]["status"] == "ok"
     interior = [
         (q["force_N"], i, q)
         for i, p in enumerate(doc["positions"])
