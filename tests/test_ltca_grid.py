@@ -76,6 +76,9 @@ def test_near_cells_is_the_sample_test_when_the_valley_is_seen(face_gear):
 
 def test_the_zone_holds_every_pair_whose_closest_point_is_within_the_gap(face_gear):
     tca, positions = face_gear
+    # position 10 (φ1 = −1.44°): pair (1, 1) is 13.6 µm from contact at its closest point, every
+    # coarse sample of its separation reads 23 µm or more (measured)
+    positions = positions[10:11]
     gap = 0.02
     z = contact_zone(positions, tca.fm1.bounds, tca.fm2.bounds, tca.asm.side1, tca.asm.side2, gap)
     zone_pairs = {tuple(p) for p in z.pairs.tolist()}
@@ -86,7 +89,7 @@ def test_the_zone_holds_every_pair_whose_closest_point_is_within_the_gap(face_ge
         if ok and b <= gap
     }
     assert within and within <= zone_pairs
-    # pair (1, 1) is one of them: 20 µm reached between the samples only
+    # pair (1, 1) is one of them: within 20 µm between the samples only
     sampled = {
         (int(g.k), int(g.j))
         for p in positions

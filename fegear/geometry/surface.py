@@ -26,7 +26,7 @@ curvatures and orthonormal principal directions.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
@@ -72,6 +72,21 @@ class FlankBoundaries:
         Face ends: toe/heel (bevel), inner/outer radius (face gear), ``∓b/2`` (cylindrical).
     u_name, v_name
         What ``u`` and ``v`` are for this family, with units (for messages and plots).
+    height
+        Optional ``height(u, v) -> h`` (mm, broadcast): the physical profile coordinate of flank
+        coordinates (the face gear's height above the pitch plane, the bevel's height above the
+        pitch cone). Families whose working surface is bounded by *curves* over the face make
+        ``u`` a fraction of the working height, so that ``[u_fillet, u_tip] × [v_start, v_end]``
+        is exactly the curved working surface for every consumer; ``height`` gives the curves
+        back in physical terms (:meth:`fillet_curve`, :meth:`tip_curve`) for plots and reports.
+        None: ``u`` is itself the profile coordinate and the limits are constant (involute).
+    height_name
+        What ``height`` is, with units.
+
+    Notes
+    -----
+    Consumers test a point against the working surface with :meth:`contains`, in flank
+    coordinates.
     """
 
     u_root: float
@@ -81,6 +96,8 @@ class FlankBoundaries:
     v_end: float
     u_name: str = "u"
     v_name: str = "v"
+    height: Callable[[ArrayLike, ArrayLike], Array] | None = field(default=None, compare=False)
+    height_name: str = ""
 
     def __post_init__(self) -> None:
         if not (self.u_root <= self.u_fillet <= self.u_tip):
@@ -92,6 +109,32 @@ class FlankBoundaries:
             raise ValueError(
                 f"FlankBoundaries needs v_start < v_end, got {self.v_start}, {self.v_end}"
             )
+
+    def profile(self, u: ArrayLike, v: ArrayLike) -> Array:
+        """Physical profile coordinate of flank coordinates (``height`` or ``u`` itself)."""
+        if self.height is None:
+            return np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))[0].copy()
+        return np.asarray(self.height(u, v), float)
+
+    def fillet_curve(self, v: ArrayLike) -> Array:
+        """The fillet limit as a curve over the face: profile coordinate at ``u_fillet``."""
+        return self.profile(self.u_fillet, v)
+
+    def tip_curve(self, v: ArrayLike) -> Array:
+        """The tip limit as a curve over the face: profile coordinate at ``u_tip``."""
+        return self.profile(self.u_tip, v)
+
+    def contains(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-9) -> NDArray[np.bool_]:
+        """Flank coordinates on the working surface (relative tolerance ``tol`` of the spans)."""
+        u, v = np.asarray(u, float), np.asarray(v, float)
+        tu = tol * (self.u_tip - self.u_fillet)
+        tv = tol * (self.v_end - self.v_start)
+        return (
+            (u >= self.u_fillet - tu)
+            & (u <= self.u_tip + tu)
+            & (v >= self.v_start - tv)
+            & (v <= self.v_end + tv)
+        )
 
 
 @dataclass(frozen=True)

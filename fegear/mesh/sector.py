@@ -22,13 +22,19 @@ Construction (gmsh, OpenCASCADE kernel; :mod:`fegear.mesh.sector_geometry` compu
 4. Faces are named *geometrically*: envelope faces by their cone coordinates, loft faces by the
    nearest section edge (majority vote of a 5 × 5 parametric sample of the face).
 
-Fillets: the involute family models the generated trochoidal fillet (and the root circle
-between them). Face gear and spiral bevel geometry stop at the fillet limit; the sector closes
-each tooth space with a *root blend*: a cubic Hermite curve from the flank bottom (flank
-tangent) to the space middle on the root surface (tangent along the root), tangents scaled to
-the chord (given to OCC as the equivalent Bézier, so the volume estimate can use the same curve),
-lofted along the face. It is not the generated fillet; it is there to carry the tooth-root
-compliance.
+Fillets: the involute and face-gear families model the generated fillet (the involute's
+trochoid from the rack tip, the face gear's trace of the shaper's tip edge,
+:mod:`fegear.geometry.face_gear_fillet`) and the root between the fillets of a tooth space. Each
+section carries them as one edge per space half (space middle → root → fillet → fillet limit)
+through 25 exact points at about equal arc lengths (:func:`~.sector_geometry._root_fillet`), so
+that the loft stays regular where the face-gear fillet shrinks from 7 mm at the inner end to a
+point at 555 mm (where the shaper tip rolls on the root plane); fillet nodes lie within 0.011 mm
+of the exact fillet on the level-0 seed sector (``tests/test_mesh_sector.py``). The spiral bevel
+stops at the fillet limit and closes each tooth space with a *root blend*: a cubic Hermite curve
+from the flank bottom (flank tangent) to the space middle on the root surface (tangent along the
+root), tangents scaled to the chord (given to OCC as the equivalent Bézier, so the volume
+estimate can use the same curve), lofted along the face. It is not the generated fillet; it is
+there to carry the tooth-root compliance.
 
 Boundary conditions meant for this mesh (applied by the compliance stage): ``bore`` (involute
 and spiral bevel members: bore, or rim-bottom cone ``rim_modules · m`` below the root cone) or
@@ -53,7 +59,7 @@ import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import NamedTuple
@@ -92,8 +98,8 @@ Array = NDArray[np.float64]
 FINE = (0.45, 0.32, 0.22, 0.16, 0.11)
 #: coarse (far-field) element size per level, in modules
 COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
-#: 4: flat surface triangles re-meshed (_fix_flat_triangles); 3: zone seeds interpolated
-_VERSION = "sector-4"
+#: 5: generated face-gear fillet; 4: flat surface triangles re-meshed; 3: zone seeds interpolated
+_VERSION = "sector-5"
 
 
 class FlankZone(NamedTuple):
@@ -147,6 +153,10 @@ class SectorMesh:
         Measured numbers: mesh time, minimum SICN, CAD volume, flank CAD deviation, …
     path
         The cached ``.msh`` file.
+    zone_points
+        ``(m, 3)`` points on the flanks covering the zone boxes about ``h_fine/2`` apart
+        (member frame, on their teeth), or None: where contact can happen, for the stages that
+        model only that (the compliance operator).
     """
 
     member: str
@@ -157,6 +167,7 @@ class SectorMesh:
     parameters: Mapping[str, object]
     diagnostics: Mapping[str, object] = field(default_factory=dict)
     path: Path | None = None
+    zone_points: Array | None = None
 
     @property
     def n_teeth(self) -> int:
@@ -636,8 +647,12 @@ def sector_mesh(
     public = {k: v for k, v in params.items() if k != "member"}
     public["member_name"] = getattr(member, "name", "")
     public["h_fine_mm"], public["h_coarse_mm"] = mesh_sizes(fr.module, level)
-    return load_sector_mesh(path, member=getattr(member, "name", ""), family=fr.family,
-                            parameters=public, diagnostics=diag)  # fmt: skip
+    h_fine = public["h_fine_mm"]
+    return replace(
+        load_sector_mesh(path, member=getattr(member, "name", ""), family=fr.family,
+                         parameters=public, diagnostics=diag),
+        zone_points=_zone_points(fr, zone, 0.5 * h_fine, n_teeth),
+    )  # fmt: skip
 
 
 def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray[np.int64]]]:

@@ -56,6 +56,7 @@ __all__ = [
     "hermite_points",
     "section_integral_volume",
     "flank_distance",
+    "fillet_distance",
 ]
 
 log = logging.getLogger(__name__)
@@ -225,7 +226,7 @@ def sector_frame(member: GeneratedMember, rim_modules: float = 3.0) -> SectorFra
             L_start=d.inner_radius_mm, L_end=d.outer_radius_mm,
             L_range=(d.inner_radius_mm - 1.0, d.outer_radius_mm + 1.0), n_sections=13,
             u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side="drive",
-            bottom_name="base", has_fillet=False,
+            bottom_name="base", has_fillet=True,
         )  # fmt: skip
     if isinstance(member, SpiralBevelMember):
         bl = member.blank
@@ -281,33 +282,72 @@ def sections_edges(
     space middle); then ``cut_right`` (down to the loft bottom), ``bottom`` (trimmed away later),
     ``cut_left``. Labels name the physical group the lofted face will belong to. Flank edges
     interpolate ``nu`` exact points ``p(u, v = L)`` (``u`` fillet limit → tip) with exact end
-    tangents (central differences, step ``1e-5`` of the profile), evenly spaced in ``u``; the
-    involute fillet likewise (``nu`` points; cosine spacing was tried: it halves the section
-    error but gives the OCC loft slivers near the ends).
+    tangents (central differences, step ``1e-5`` of the profile), evenly spaced in ``u``
+    (cosine spacing was tried: it halves the section error but gives the OCC loft slivers near
+    the ends); root and generated fillet as :func:`_root_fillet` gives them.
     """
     fr = frame
     ks = np.array([j - n_teeth // 2 for j in range(-1, n_teeth + 1)], dtype=float)
     s01 = np.linspace(0.0, 1.0, nu)
     uw = fr.u_fillet + (fr.u_tip - fr.u_fillet) * s01
     eps = 1e-5 * (fr.u_tip - fr.u_root)
-    uf = fr.u_root + (fr.u_fillet - fr.u_root) * s01 if fr.has_fillet else None
-    uu = [uw, np.array([fr.u_fillet - eps, fr.u_fillet + eps, fr.u_tip - eps, fr.u_tip])]
-    if uf is not None:
-        uu.append(uf)
-    allu = np.concatenate(uu)
+    allu = np.concatenate([uw, [fr.u_fillet - eps, fr.u_fillet + eps, fr.u_tip - eps, fr.u_tip]])
     n1 = len(uw)
     Ls = np.asarray(Ls, dtype=float)
     raw = {}
     for s in ("drive", "coast"):
-        p0 = fr.flank_points(s, allu[None, :], Ls[:, None])  # (nL, nu, 3)
-        raw[s] = _rotate(p0[:, None], ks[None, :, None] * fr.tau)  # (nL, nk, nu, 3)
+        p0 = fr.flank_points(s, allu[None, :], Ls[:, None])  # (nL, nu + 4, 3)
+        raw[s] = _rotate(p0[:, None], ks[None, :, None] * fr.tau)  # (nL, nk, nu + 4, 3)
+    rf = _root_fillet(fr, Ls) if fr.has_fillet else None
     ks_i = [int(k) for k in ks]
-    return [
-        _section(fr, n_teeth, float(L), ks_i, raw, i, n1, uf is not None) for i, L in enumerate(Ls)
-    ]
+    return [_section(fr, n_teeth, float(L), ks_i, raw, i, n1, rf) for i, L in enumerate(Ls)]
 
 
-def _section(fr, n_teeth, L, ks, raw, iL, n1, with_fillet) -> list[Edge]:
+def _root_fillet(
+    fr: SectorFrame, Ls: Array, n: int = 25, n_dense: int = 97
+) -> dict[str, tuple[Array, Array]]:
+    """Per side, the root and generated fillet of member tooth 0 at the sections ``Ls``: points
+    ``(nL, n, 3)`` from the middle of the tooth space on that side (along the root arc, then up
+    the fillet) to the fillet limit, and the polar angles ``(nL,)`` of the space middles.
+
+    Every point is exact (root arc ``h = root(L)``; fillet ``p(u, L)``, ``u_root … u_fillet``)
+    and they lie at about equal arc lengths (the fillet's ``u`` interpolated from the chord
+    lengths of ``n_dense`` exact samples), so that every section carries the same number of
+    points in the same places along its edge and the loft stays regular where a face-gear
+    fillet shrinks from 7 mm to a point (where the shaper tip rolls on the root plane, ``L =
+    r_as/q``). Raises :class:`~fegear.errors.MeshError` if the fillets of a tooth space cross.
+    """
+    plus, minus = fr.plus_side, fr.minus_side
+    ud = fr.u_root + (fr.u_fillet - fr.u_root) * np.linspace(0.0, 1.0, n_dense)
+    dense = {s: fr.flank_points(s, ud[None, :], Ls[:, None]) for s in (plus, minus)}
+    phib = {s: _polar(dense[s][:, 0]) for s in (plus, minus)}  # fillet bottoms
+    gap = phib[minus] + fr.tau - phib[plus]
+    if np.any(gap <= 0):
+        L_bad = float(Ls[np.argmin(gap)])
+        raise MeshError(f"the fillets of a tooth space cross at L = {L_bad:.3f}")
+    mid = {plus: phib[plus] + 0.5 * gap, minus: phib[minus] - 0.5 * gap}
+    rho_root = fr.rho_z(Ls, fr.root(Ls))[0]
+    out = {}
+    for s in (plus, minus):
+        root_len = rho_root * np.abs(phib[s] - mid[s])  # (nL,)
+        cum = np.concatenate(
+            [np.zeros((len(Ls), 1)),
+             np.cumsum(np.linalg.norm(np.diff(dense[s], axis=1), axis=-1), axis=1)], axis=1,
+        )  # fmt: skip
+        total = root_len + cum[:, -1]
+        t = total[:, None] * np.linspace(0.0, 1.0, n)[None, :]  # (nL, n)
+        on_root = t < root_len[:, None]
+        phi = mid[s][:, None] + (phib[s] - mid[s])[:, None] * t / root_len[:, None]
+        u = np.stack([np.interp(t[i] - root_len[i], cum[i], ud) for i in range(len(Ls))])
+        u[:, -1] = fr.u_fillet
+        LL = np.broadcast_to(Ls[:, None], u.shape)
+        pts = fr.flank_points(s, u, LL)
+        pr = fr.point(LL, fr.root(LL), phi)
+        out[s] = (np.where(on_root[..., None], pr, pts), mid[s])
+    return out
+
+
+def _section(fr, n_teeth, L, ks, raw, iL, n1, rf) -> list[Edge]:
     data: dict[tuple[int, str], dict[str, Array]] = {}
     for ik, k in enumerate(ks):
         for side in ("drive", "coast"):
@@ -317,14 +357,20 @@ def _section(fr, n_teeth, L, ks, raw, iL, n1, with_fillet) -> list[Edge]:
                 "work": pts[:n1],
                 "t_fil": _unit(e[1] - e[0]),
                 "t_tip": _unit(e[3] - e[2]),
-                "fillet": pts[n1 + 4 :] if with_fillet else pts[:1],
             }
+            if rf is not None:
+                data[(k, side)]["fillet"] = _rotate(rf[side][0][iL], k * fr.tau)
+                data[(k, side)]["mid"] = float(rf[side][1][iL] + k * fr.tau)
     plus, minus = fr.plus_side, fr.minus_side
 
     def space_mid(k_left: int) -> tuple[Array, Array]:
-        a = data[(k_left, plus)]["fillet"][0]
-        b = data[(k_left + 1, minus)]["fillet"][0]
-        pa, pb = _polar(a), _polar(b)
+        if rf is not None:
+            phi = data[(k_left, plus)]["mid"]
+            return fr.surface_point(fr.root, phi, L), fr.surface_tangent(phi)
+        pa, pb = (
+            _polar(data[(k_left, plus)]["work"][0]),
+            _polar(data[(k_left + 1, minus)]["work"][0]),
+        )
         if pb <= pa:
             raise MeshError(f"tooth space after tooth {k_left} is closed at L = {L:.3f}")
         phi = 0.5 * (pa + pb)
@@ -338,7 +384,7 @@ def _section(fr, n_teeth, L, ks, raw, iL, n1, with_fillet) -> list[Edge]:
         dm, dp = data[(k, minus)], data[(k, plus)]
         # minus fillet: space middle -> fillet limit
         if fr.has_fillet:
-            pts = np.vstack([mid, dm["fillet"]])
+            pts = np.vstack([mid, dm["fillet"][1:]])
             edges.append(Edge(f"fillet_{j}", pts, t_mid, dm["t_fil"]))
         else:
             edges.append(Edge(f"fillet_{j}", np.vstack([mid, dm["work"][0]]), t_mid, dm["t_fil"]))
@@ -349,7 +395,7 @@ def _section(fr, n_teeth, L, ks, raw, iL, n1, with_fillet) -> list[Edge]:
         edges.append(Edge(f"flank_{plus}_{j}", dp["work"][::-1], -dp["t_tip"], -dp["t_fil"]))
         nxt, t_nxt = space_mid(k)
         if fr.has_fillet:
-            pts = np.vstack([dp["fillet"][::-1], nxt])
+            pts = np.vstack([dp["fillet"][:0:-1], nxt])
             edges.append(Edge(f"fillet_{j}", pts, -dp["t_fil"], t_nxt))
         else:
             edges.append(Edge(f"fillet_{j}", np.vstack([dp["work"][0], nxt]), -dp["t_fil"], t_nxt))
@@ -396,8 +442,8 @@ def section_integral_volume(frame: SectorFrame, n_teeth: int, n_L: int = 21, nu:
     straight parts), Simpson's rule over ``n_L`` sections in ``L``.
 
     Independent of the CAD loft, the trimming and the mesh; it models the *same* solid, so the
-    root of families without a generated fillet (face gear, spiral bevel) is the sector's cubic
-    root blend (:func:`hermite_points`, 41 points), not the generated fillet.
+    root of a family without a generated fillet (spiral bevel) is the sector's cubic root blend
+    (:func:`hermite_points`, 41 points), not the generated fillet.
     """
     fr = frame
     M = fr.meridian
@@ -436,9 +482,10 @@ def flank_distance(
     (scalar or ``(m,)``).
 
     Closest-point Gauss-Newton on ``|p(a, b) − x|²`` from the nearest point of an
-    ``n_grid × n_grid`` sample of the flank, no bounds on the parameters. Spiral bevel: in the
-    cutter parameters ``(a, b) = (s, θ)`` with the exact tangents of the native evaluator;
-    other families: in ``(u, v)`` with finite-difference tangents. Returns the distances
+    ``n_grid × n_grid`` sample of the flank. Spiral bevel: in the cutter parameters
+    ``(a, b) = (s, θ)`` with the exact tangents of the native evaluator, unbounded; other
+    families: in ``(u, v)`` with finite-difference tangents, ``u`` projected onto the working
+    flank ``[u_fillet, u_tip]`` (below it the parameters run onto the fillet). Returns the distances
     ``(m,)`` mm and the parameters ``(m, 2)``.
     """
     fr = frame
@@ -458,6 +505,7 @@ def flank_distance(
             return p, pa, pb
 
         a0, b0, ha, hb = S.ravel(), T.ravel(), np.ptp(S), np.ptp(T)
+        box = None
     else:
         G = fr.member.point_normal(side, U, V)[0].reshape(-1, 3)
         hu = 1e-6 * (fr.u_tip - fr.u_fillet)
@@ -470,6 +518,9 @@ def flank_distance(
             return P[0], (P[1] - P[0]) / hu, (P[2] - P[0]) / hv
 
         a0, b0, ha, hb = U.ravel(), V.ravel(), fr.u_tip - fr.u_fillet, fr.L_end - fr.L_start
+        # the working flank only: below u_fillet the parameters run onto the fillet, another
+        # surface (degenerate where a face-gear fillet shrinks to a point); projected steps
+        box = (fr.u_fillet, fr.u_tip)
     idx = np.argmin(((x[:, None, :] - G[None, :, :]) ** 2).sum(-1), axis=1)
     a, b = a0[idx].copy(), b0[idx].copy()
     for _ in range(15):
@@ -480,7 +531,34 @@ def flank_distance(
         det = a11 * a22 - a12**2
         da, db = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
         a, b = a + da, b + db
+        if box is not None:
+            a = np.clip(a, *box)
         if np.max(np.abs(da)) < 1e-9 * ha and np.max(np.abs(db)) < 1e-9 * hb:
             break
     p = point_tangents(a, b)[0]
     return np.linalg.norm(p - x, axis=-1), np.stack([a, b], -1)
+
+
+def fillet_distance(frame: SectorFrame, k: Array | int, x: Array, n: int = 401) -> Array:
+    """Distance (mm) of points ``x (m, 3)`` on the root/fillet faces of member teeth ``k`` to the
+    exact root and generated fillet: the distance, within the section ``L = const`` of each
+    point, to the nearer of the two exact section curves of that tooth
+    (:func:`_root_fillet` with ``n`` points, a polyline whose chords sag ~1e-4 mm). It bounds the
+    3-D distance to the surface from above. Families with a generated fillet only."""
+    fr = frame
+    if not fr.has_fillet:
+        raise MeshError(f"{fr.family}: no generated fillet to measure against")
+    x = np.asarray(x, dtype=float)
+    ang = -np.broadcast_to(np.asarray(k, dtype=float), x.shape[:1]) * fr.tau
+    x = _rotate(x, ang)
+    L = fr.lh(x)[0]
+    best = np.full(len(x), np.inf)
+    for pts, _ in _root_fillet(fr, L, n=n).values():
+        a, b = pts[:, :-1], pts[:, 1:]  # (m, n - 1, 3) segments
+        ab = b - a
+        t = np.clip(
+            np.sum((x[:, None] - a) * ab, -1) / np.maximum(np.sum(ab * ab, -1), 1e-300), 0, 1
+        )
+        d = np.linalg.norm(a + t[..., None] * ab - x[:, None], axis=-1).min(axis=1)
+        best = np.minimum(best, d)
+    return best

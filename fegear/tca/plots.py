@@ -9,7 +9,7 @@ import numpy as np
 
 from .results import CycleResult
 
-__all__ = ["plot_te", "plot_paths", "plot_pattern", "plot_assembly_conventions"]
+__all__ = ["plot_te", "plot_paths", "plot_pattern", "plot_assembly_conventions", "flank_outline"]
 
 
 def _plt():
@@ -62,30 +62,25 @@ def plot_paths(
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 4))
+
+    def y(uv):  # the profile coordinate drawn: physical where the family defines it
+        return uv[:, 0] if bounds is None else bounds.profile(uv[:, 0], uv[:, 1])
+
     for i, (label, r) in enumerate(results.items()):
         uv = r.gear_uv if member == "gear" else r.pinion_uv
         m = r.has_contact
-        ax.plot(uv[m, 1], uv[m, 0], "-o", ms=3, color=f"C{i}", label=label)
+        ax.plot(uv[m, 1], y(uv[m]), "-o", ms=3, color=f"C{i}", label=label)
         e = r.edge & m
         if e.any():
-            ax.plot(uv[e, 1], uv[e, 0], "x", ms=7, color=f"C{i}")
+            ax.plot(uv[e, 1], y(uv[e]), "x", ms=7, color=f"C{i}")
         if ellipses:
+            yy = y(uv)
             for k in np.nonzero(m)[0]:
                 a = r.paint_axes_mm[k, 0]
                 if a > 0:
-                    ax.plot([uv[k, 1] - a, uv[k, 1] + a], [uv[k, 0]] * 2, color=f"C{i}", lw=0.4)
+                    ax.plot([uv[k, 1] - a, uv[k, 1] + a], [yy[k]] * 2, color=f"C{i}", lw=0.4)
     if bounds is not None:
-        b = bounds
-        ax.plot(
-            [b.v_start, b.v_end, b.v_end, b.v_start, b.v_start],
-            [b.u_fillet, b.u_fillet, b.u_tip, b.u_tip, b.u_fillet],
-            "k-",
-            lw=1,
-        )
-        ax.annotate(labels[0], (b.v_start, b.u_tip), textcoords="offset points", xytext=(2, 4))
-        ax.annotate(labels[1], (b.v_end, b.u_tip), textcoords="offset points", xytext=(-30, 4))
-        ax.set_xlabel(b.v_name)
-        ax.set_ylabel(b.u_name)
+        flank_outline(ax, bounds, labels)
     ax.set_title(title or f"contact paths on the {member} flank (x: edge contact)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
@@ -93,6 +88,22 @@ def plot_paths(
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)
+
+
+def flank_outline(ax, bounds, labels: Sequence[str] = ("", "")) -> None:
+    """Draw the working surface of a flank on ``ax``: face (``v``) across, the profile
+    coordinate up — physical (:meth:`FlankBoundaries.profile`) where the family defines it, so
+    a fillet limit that is a curve over the face is drawn as one."""
+    b = bounds
+    v = np.linspace(b.v_start, b.v_end, 121)
+    lo, hi = b.fillet_curve(v), b.tip_curve(v)
+    ax.plot(np.r_[v, v[::-1], v[:1]], np.r_[lo, hi[::-1], lo[:1]], "k-", lw=1)
+    if labels[0]:
+        ax.annotate(labels[0], (v[0], hi[0]), textcoords="offset points", xytext=(2, 4))
+    if labels[1]:
+        ax.annotate(labels[1], (v[-1], hi[-1]), textcoords="offset points", xytext=(-30, 4))
+    ax.set_xlabel(b.v_name)
+    ax.set_ylabel(b.height_name or b.u_name)
 
 
 def plot_pattern(r: CycleResult, path: str | Path, bounds=None, title: str = "") -> Path:

@@ -184,16 +184,9 @@ def line_hit(
 
 
 def in_bounds(fm: FlankMap, u: Array, v: Array, tol: float = 1e-9) -> Array:
-    """Flank coordinates inside the working flank (relative tolerance ``tol`` of the spans)."""
-    bd = fm.bounds
-    tu = tol * (bd.u_tip - bd.u_fillet)
-    tv = tol * (bd.v_end - bd.v_start)
-    return (
-        (u >= bd.u_fillet - tu)
-        & (u <= bd.u_tip + tu)
-        & (v >= bd.v_start - tv)
-        & (v <= bd.v_end + tv)
-    )
+    """Flank coordinates inside the working flank (relative tolerance ``tol`` of the spans;
+    :meth:`~fegear.geometry.surface.FlankBoundaries.contains`)."""
+    return fm.bounds.contains(u, v, tol)
 
 
 def wrap(x: Array) -> Array:

@@ -17,7 +17,8 @@ coordinates* ``(u, v)`` (profile × face, with :class:`~fegear.geometry.surface.
   (:class:`~fegear.geometry.spiral_bevel.NativeFlank`); analytic Jacobian.
 - :class:`FaceGearMap`: face gear with γ = 90°: Litvin's closed form (Litvin & Fuentes 2004
   §19.3; :func:`fegear.geometry.face_gear.closed_form_point`), native ``(t, ψ)`` = shaper roll and
-  shaper angle; flank coordinates ``(z, √(x² + y²))``.
+  shaper angle; flank coordinates: the fraction of the working height between the fillet-limit
+  curve and the tip plane, and the radius ``√(x² + y²)``.
 
 Jacobians of the Newton solves are finite differences of these exact evaluators (the residuals
 are exact, so the converged points are exact; the Jacobian only sets the convergence rate).
@@ -193,17 +194,22 @@ class FaceGearMap(FlankMap):
         return p, n
 
     def flank(self, a, b, p):
-        return p[..., 2], np.hypot(p[..., 0], p[..., 1])
+        rho = np.hypot(p[..., 0], p[..., 1])
+        return self.member.working_u(p[..., 2], rho, self.side), rho
 
     def native(self, u, v):
+        m = self.member
         u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
-        env, t, _ = self.member._solve(self.side, u, v)
+        env, t, _ = m._solve(self.side, m.height(u, v, self.side), v)
         return np.asarray(t, float), np.asarray(env.psi, float)
 
     def _native_box(self):
+        # the working surface is curved in (t, ψ) too: sample its whole boundary
         bd = self.bounds
-        U, V = np.meshgrid([bd.u_fillet, bd.u_tip], [bd.v_start, bd.v_end])
-        a, b = self.native(U, V)
+        s = np.linspace(0.0, 1.0, 9)
+        U = np.concatenate([np.full(9, bd.u_fillet), np.full(9, bd.u_tip), s, s])
+        V = np.concatenate([s, s, np.zeros(9), np.ones(9)]) * (bd.v_end - bd.v_start)
+        a, b = self.native(U, bd.v_start + V)
         return np.array([a.min(), b.min()]), np.array([a.max(), b.max()])
 
 
