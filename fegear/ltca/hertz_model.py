@@ -34,12 +34,13 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.optimize import brentq
 
 from fegear.contact import ContactSolution
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
-from fegear.ltca.grid import _separation, pair_cells, tca_edge_names
+from fegear.ltca.grid import _separation, pair_cells, take_cells, tca_edge_names
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
@@ -116,11 +117,14 @@ def _hessian(tca: TCA, pos: PositionResult, i: int, step_mm: float):
     return H, float(h[4]), (lu, lv)
 
 
-def pair_laws(tca, pos, models, torque2_Nmm, E, nu):
-    """The law of every modelled pair at this position, with ``b_i`` and ``h_i``."""
+def pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=None):
+    """The law of every modelled pair at this position (of the grids ``only``, indices into
+    ``pos.grids``, if given), with ``b_i`` and ``h_i``."""
     E_star = effective_modulus(E, nu, E, nu)
     out, warnings = [], []
     for gi, g in enumerate(pos.grids):
+        if only is not None and gi not in only:
+            continue
         i = int(np.flatnonzero((tca.pairs[:, 0] == g.k) & (tca.pairs[:, 1] == g.j))[0])
         if not (pos.pair_valid[i] and models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
             continue
@@ -197,22 +201,80 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
             break
     if cells is None:
         return 0.0, "no FE cells at the closest point: lumped compliance 0"
-    C = _solve_cells_compliance(tca, pos, models, [cells])
     # the unit load: along the whole band for a line contact; for a point contact on the cells
     # within 2.5 cells of the pair's closest point, a patch the FE resolves (a single coarse cell
-    # would be under-resolved and the FE stiffer than the half-space)
+    # would be under-resolved and the FE stiffer than the half-space). Only those cells enter
+    # wᵀ C w (C is pairwise): the others are left out before C is made.
     i = int(np.flatnonzero((tca.pairs[:, 0] == cells.k) & (tca.pairs[:, 1] == cells.j))[0])
     r = np.linalg.norm(cells.centers - pos.points[i], axis=1)
     near = np.ones(cells.n, dtype=bool) if line else r <= 2.5 * float(np.max(cells.cell_mm))
     if not near.any():
         near = r <= r.min() + 1e-12
-    w = np.where(near, 1.0 / near.sum(), 0.0)
+    cells = take_cells(cells, np.flatnonzero(near))
+    # the compliance operators cover the flank facets of the sectors' contact zone only
+    # (fegear.ltca.model.zone_facets): a pair at the zone's fringe keeps the cells they cover
+    covered = _covered(tca, pos, models, cells)
+    note = ""
+    if not covered.all():
+        if not covered.any():
+            return 0.0, "closest point outside the sectors' contact zone: lumped compliance 0"
+        note = (
+            f"{int((~covered).sum())} of {cells.n} unit-load cells outside the sectors' contact "
+            "zone: left out of the lumped compliance"
+        )
+        cells = take_cells(cells, np.flatnonzero(covered))
+    C = _solve_cells_compliance(tca, pos, models, [cells])
+    w = np.full(cells.n, 1.0 / cells.n)
     lay = tangent_layout(cells.centers, cells.centers, cells.normals, cells.edges)
     S = 2.0 * layout_influence(lay, 0.0, E, nu)
     c = float(w @ C @ w - w @ S @ w)
     if c < 0.0:
-        return 0.0, f"FE stiffer than the half-space at this level (c = {c:.3g} mm/N): clipped to 0"
-    return c, ""
+        clip = f"FE stiffer than the half-space at this level (c = {c:.3g} mm/N): clipped to 0"
+        return 0.0, "; ".join(filter(None, (note, clip)))
+    return c, note
+
+
+def _covered(tca, pos, models, cells) -> np.ndarray:
+    """``(n,)`` bool: the cells whose consistent loads lie on DOFs both members' compliance
+    operators cover (their load DOFs, or constrained DOFs)."""
+    from fegear.ltca.model import cell_load_operators
+
+    M1, M2 = tca.asm.placement1(pos.phi1), tca.asm.placement2(pos.phi2)
+    ok = np.ones(cells.n, dtype=bool)
+    loads = cell_load_operators(models, M1, M2, [cells])
+    for model, P in zip((models.pinion, models.gear), loads, strict=True):
+        outside = np.ones(P.shape[0])
+        outside[np.union1d(model.op.cols, model.op.fixed)] = 0.0
+        ok &= (abs(sp.csr_matrix(P)).T @ outside) == 0.0
+    return ok
+
+
+def _backlash(tca, pos, g) -> float:
+    """mm, separation at the closest point of the pair of grid ``g`` (inf if not valid)."""
+    i = int(np.flatnonzero((tca.pairs[:, 0] == g.k) & (tca.pairs[:, 1] == g.j))[0])
+    return float(pos.backlash_mm[i]) if pos.pair_valid[i] else np.inf
+
+
+def _closes(tca, pos, g, theta: float) -> bool:
+    """Whether the lag ``theta`` closes the pair of grid ``g`` at its closest point."""
+    i = int(np.flatnonzero((tca.pairs[:, 0] == g.k) & (tca.pairs[:, 1] == g.j))[0])
+    return bool(pos.pair_valid[i] and pos.backlash_rad[i] < theta)
+
+
+def _lag(laws, torque2_Nmm: float) -> float:
+    """The lag ``θ`` (rad) at which the pairs' forces balance the torque."""
+    hvec = np.array([h for (_, _, _, _, h, _) in laws])
+
+    def residual(theta: float) -> float:
+        forces = np.array([law.force(theta * h - b) for (_, _, _, b, h, law) in laws])
+        return float(hvec @ forces) - torque2_Nmm
+
+    hi = max(1e-9, min(b / h for (_, _, _, b, h, _) in laws) + 1e-7)
+    while residual(hi) < 0.0:
+        hi *= 2.0
+    # relative tolerance only: an absolute one (1e-16 rad, once) is a large part of the lag at
+    # a tiny torque (1e-6 N·m on FZG: lag ~1e-10 rad, the shares summed to 1 + 6.9e-6)
+    return float(brentq(residual, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS))
 
 
 def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> LoadedPosition:
@@ -221,25 +283,27 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
 
     if not pos.has_contact:
         return _no_contact(pos, "no contact: the flanks do not meet at this position")
-    laws, warnings = pair_laws(tca, pos, models, torque2_Nmm, E, nu)
+    # Pairs farther from contact than the sectors' contact zone reaches get their law only if the
+    # solved lag closes them: the compliance operators cover the flank facets of the zone only
+    # (fegear.ltca.model.zone_facets), and a law's lumped compliance reads the FE at the pair's
+    # closest point (FZG: pairs 2.8 and 6.4 mm from contact at their tips).
+    reach = float(models.zone.gap_mm) if models.zone is not None else np.inf
+    near = {gi for gi, g in enumerate(pos.grids) if _backlash(tca, pos, g) <= reach}
+    laws, warnings = pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=near)
     if not laws:
         return _no_contact(pos, "no pair with a Hertz law at this position")
-
-    def forces(theta: float) -> np.ndarray:
-        return np.array([law.force(theta * h - b) for (_, _, _, b, h, law) in laws])
-
+    far = [gi for gi in range(len(pos.grids)) if gi not in near]
+    while True:
+        theta = _lag(laws, torque2_Nmm)
+        closing = [gi for gi in far if _closes(tca, pos, pos.grids[gi], theta)]
+        if not closing:
+            break
+        more, notes = pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=set(closing))
+        laws += more
+        warnings += notes
+        far = [gi for gi in far if gi not in closing]
     hvec = np.array([h for (_, _, _, _, h, _) in laws])
-
-    def residual(theta: float) -> float:
-        return float(hvec @ forces(theta)) - torque2_Nmm
-
-    hi = max(1e-9, min(b / h for (_, _, _, b, h, _) in laws) + 1e-7)
-    while residual(hi) < 0.0:
-        hi *= 2.0
-    # relative tolerance only: an absolute one (1e-16 rad, once) is a large part of the lag at
-    # a tiny torque (1e-6 N·m on FZG: lag ~1e-10 rad, the shares summed to 1 + 6.9e-6)
-    theta = brentq(residual, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS)
-    F = forces(theta)
+    F = np.array([law.force(theta * h - b) for (_, _, _, b, h, law) in laws])
     eq = abs(hvec @ F - torque2_Nmm) / torque2_Nmm
     loads = []
     E_star = effective_modulus(E, nu, E, nu)
