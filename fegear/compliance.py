@@ -36,6 +36,7 @@ from __future__ import annotations
 import logging
 import time
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -344,6 +345,7 @@ def candidate_operator(
     backend: str = "auto",
     cache_key: dict | None = None,
     load_dofs: np.ndarray | None = None,
+    groups: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> CandidateOperator:
     """``(K^{-1})_{cf}`` on the candidate DOFs ``c = dofs`` and the load DOFs ``f = load_dofs``
     (full numbering; default all of ``dofs``; clamped ones dropped from both; ``f ⊂ c``).
@@ -351,11 +353,23 @@ def candidate_operator(
     With ``cache_key`` (a mapping describing the mesh, material and boundary conditions), the
     block is read from / written to the on-disk cache; the candidate and load DOFs are part of the
     key.
+
+    ``groups`` (``[(load_g, read_g), ...]``, e.g. one per loaded tooth: its flank DOFs and the
+    DOFs of the layer below them) says which read-only rows are ever read under which loads: then
+    only ``G_ff`` (every load DOF under every load: the coupling of all teeth) and the blocks
+    ``G_{read_g, load_g}`` are computed, each as the inverse of its own Schur complement (for any
+    index set ``J``, ``(K^{-1})_{JJ} = (S_J)^{-1}``, ``S_J`` the Schur complement of ``K`` onto
+    ``J``): ``Σ_g cost(l_g, f_g) + f³`` instead of ``cost(Σ l_g, f)``, the dense work being cubic
+    (:func:`~fegear.linalg.inverse_columns`). The other entries of ``G`` (a layer under one tooth
+    read under the load of another) are NaN: never used, and loud if they were. Measured on the
+    seed face gear's level-0 sector (3 loaded teeth, f = 5802, l = 10 107): 18.8 s against
+    104 s for the whole block (2 cores, with another process running).
     """
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     f = c if load_dofs is None else np.intersect1d(np.asarray(load_dofs, np.int64), body.free)
     if not np.all(np.isin(f, c)):
         raise InputError("load_dofs", f"{int(np.sum(~np.isin(f, c)))} outside dofs", "within dofs")
+    blocks = None if groups is None else _groups(c, f, body.free, groups)
     pos = np.searchsorted(body.free, c)
     t0 = time.perf_counter()
     requested_backend(backend)  # a bad name is refused on a cache hit too
@@ -364,7 +378,16 @@ def candidate_operator(
     def compute() -> np.ndarray:
         nonlocal used
         used = resolve_backend(backend)  # only when computing: loading MKL takes 0.3 s
-        return inverse_columns(body.K, pos, np.isin(c, f), backend=used)
+        if blocks is None:
+            return inverse_columns(body.K, pos, np.isin(c, f), backend=used)
+        G = np.full((c.size, f.size), np.nan)
+        rf = np.searchsorted(c, f)
+        G[rf] = inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=used)
+        for fg, lg in blocks:
+            cg = np.union1d(fg, lg)
+            Gg = inverse_columns(body.K, np.searchsorted(body.free, cg), np.isin(cg, fg), used)
+            G[np.ix_(np.searchsorted(c, lg), np.searchsorted(f, fg))] = Gg[np.isin(cg, lg)]
+        return G
 
     if cache_key is None:
         G = compute()
@@ -380,6 +403,8 @@ def candidate_operator(
         }
         if f.size < c.size:
             params.update(kind="inverse_columns_v1", cols=f)
+        if blocks is not None:
+            params.update(kind="inverse_group_blocks_v1", groups=[g for b in blocks for g in b])
 
         def build(path: Path) -> None:
             with open(path, "wb") as fh:
@@ -406,6 +431,24 @@ def candidate_operator(
         cols=f,
         fixed=fixed,
     )
+
+
+def _groups(c, f, free, groups) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The groups of :func:`candidate_operator` on free DOFs, checked: load DOFs within ``f``,
+    read DOFs within ``c \\ f``, no DOF in two groups."""
+    out, seen = [], []
+    for i, (fg, lg) in enumerate(groups):
+        fg = np.intersect1d(np.asarray(fg, np.int64), free)
+        lg = np.intersect1d(np.asarray(lg, np.int64), free)
+        if not (np.all(np.isin(fg, f)) and np.all(np.isin(lg, c)) and not np.isin(lg, f).any()):
+            raise InputError(f"groups[{i}]", "DOFs", "load DOFs within load_dofs, read DOFs in "
+                             "dofs and not load DOFs")  # fmt: skip
+        out.append((fg, lg))
+        seen.append(np.concatenate([fg, lg]))
+    allg = np.concatenate(seen) if seen else np.zeros(0, np.int64)
+    if np.unique(allg).size != allg.size:
+        raise InputError("groups", "overlapping", "disjoint groups")
+    return out
 
 
 def _positions(op: CandidateOperator, M: sp.spmatrix, on: np.ndarray, what: str) -> np.ndarray:

@@ -313,13 +313,17 @@ def test_inverse_columns_are_the_columns_of_the_inverse_block(box, reference, ba
     )
 
 
-def test_inverse_columns_through_the_mkl_cholesky(box, reference, monkeypatch) -> None:
-    """The MKL dense Cholesky (used above the OpenBLAS size limit) gives the same columns."""
+@pytest.mark.parametrize("mkl_min", [10, 10**9], ids=["mkl-dense", "openblas-dense"])
+def test_inverse_columns_through_either_dense_cholesky(box, reference, monkeypatch, mkl_min):
+    """The dense Cholesky and inverse of MKL (used where MKL is at hand) and of SciPy's
+    OpenBLAS give the same columns."""
     _needs_pardiso()
-    monkeypatch.setattr(schur, "_OPENBLAS_POTRF_MAX", 10)
+    monkeypatch.setattr(schur, "_MKL_DENSE_MIN", mkl_min)
     K, idx = box
     cols = np.arange(idx.size) % 4 == 0
     assert _rel(inverse_columns(K, idx, cols, "pardiso"), reference[:, cols]) < TOL_SOLVERS
+    full = np.ones(idx.size, bool)
+    assert _rel(inverse_columns(K, idx, full, "pardiso"), reference) < TOL_SOLVERS
 
 
 def test_inverse_columns_refuses_a_bad_mask(box) -> None:
@@ -361,3 +365,37 @@ def test_operator_on_load_columns_and_its_guard() -> None:
     P_c = spread(np.concatenate([clamped, loads]), 2)
     P_only = sp.csr_matrix(P_c.toarray() * np.isin(np.arange(body.n_dofs), loads)[:, None])
     np.testing.assert_array_equal(body_compliance(narrow, P_c), body_compliance(narrow, P_only))
+
+
+def test_an_operator_in_groups_has_the_blocks_of_the_whole_one() -> None:
+    """Groups (per loaded tooth: its load DOFs and the layer DOFs read only under them) give
+    ``G_ff`` and each group's ``G_{read, load}`` as the whole operator has them (each block the
+    inverse of its own Schur complement); the blocks no group asks for are NaN."""
+    from fegear.compliance import candidate_operator
+    from fegear.fem.elasticity import assemble_body
+
+    mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 4)] * 3).with_boundaries(
+        {"bottom": lambda x: x[2] < 1e-9}
+    )
+    body = assemble_body(mesh, 206000.0, 0.3, [("bottom", "xyz")])
+    free = body.free
+    f1, f2 = free[-12:-6], free[-6:]
+    l1, l2 = free[-40:-30], free[-30:-20]
+    cand = np.concatenate([f1, f2, l1, l2])
+    loads = np.concatenate([f1, f2])
+    whole = candidate_operator(body, cand, "superlu", load_dofs=loads)
+    grouped = candidate_operator(
+        body, cand, "superlu", load_dofs=loads, groups=[(f1, l1), (f2, l2)]
+    )
+    row = {int(d): i for i, d in enumerate(whole.dofs)}
+    col = {int(d): i for i, d in enumerate(whole.cols)}
+
+    def block(op, rows, cols):
+        return op.G[np.ix_([row[int(d)] for d in rows], [col[int(d)] for d in cols])]
+
+    for rows, cols in ((loads, loads), (l1, f1), (l2, f2)):
+        # two eliminations of the same matrix: round-off apart
+        assert _rel(block(grouped, rows, cols), block(whole, rows, cols)) < TOL_SOLVERS
+    assert np.isnan(block(grouped, l1, f2)).all() and np.isnan(block(grouped, l2, f1)).all()
+    with pytest.raises(InputError, match="groups"):
+        candidate_operator(body, cand, "superlu", load_dofs=loads, groups=[(f1, l1), (f2, l1)])

@@ -381,8 +381,13 @@ def schur_complement(
     return S
 
 
-#: Largest dense Cholesky left to SciPy's LAPACK when MKL is at hand (crashes seen at 16 384).
-_OPENBLAS_POTRF_MAX = 12000
+#: Smallest dense Cholesky / inverse given to MKL when it is at hand (SciPy's OpenBLAS below).
+#: Measured on a 2-core AVX-512 EPYC, MKL 2026.2 vs SciPy 1.17's OpenBLAS, the same load on
+#: both: Cholesky n = 1000 / 5802 / 9000: 0.05 / 2.2 / 7.0 s vs 0.52 / 8.8 / 12.1 s; inverse
+#: (potrf + potri) n = 3000 / 5802: 1.4 / 6.7 s vs 8.1 / 22.2 s. (OpenBLAS was the faster one
+#: at n = 3000 on an AVX2 host, 0.35 vs 0.70 s; it also crashed on multi-threaded potrf at
+#: 16 384.) Every size that matters here goes to MKL.
+_MKL_DENSE_MIN = 500
 
 
 def inverse_block(
@@ -501,9 +506,10 @@ def inverse_columns(
 
 
 def _spd_cholesky(S: np.ndarray) -> np.ndarray:
-    """Lower Cholesky factor of a dense SPD matrix (MKL above the OpenBLAS limit)."""
+    """Lower Cholesky factor of a dense SPD matrix (MKL where available, see
+    ``_MKL_DENSE_MIN``)."""
     lib, _ = _pardiso()
-    if lib is not None and S.shape[0] > _OPENBLAS_POTRF_MAX:
+    if lib is not None and S.shape[0] >= _MKL_DENSE_MIN:
         return lib.spd_cholesky(S)
     try:
         return la.cholesky(S, lower=True, check_finite=False)
@@ -514,9 +520,7 @@ def _spd_cholesky(S: np.ndarray) -> np.ndarray:
 def _spd_inverse(S: np.ndarray) -> np.ndarray:
     """Inverse of a dense SPD matrix: LAPACK ``potrf`` + ``potri``, symmetrised exactly."""
     lib, _ = _pardiso()
-    if lib is not None and S.shape[0] > _OPENBLAS_POTRF_MAX:
-        # SciPy's OpenBLAS crashes on large multi-threaded potrf (see MklPardiso.spd_inverse);
-        # below the limit it is the faster one here (n = 3000: 0.35 s vs MKL 0.70 s, AMD EPYC).
+    if lib is not None and S.shape[0] >= _MKL_DENSE_MIN:  # see _MKL_DENSE_MIN
         return lib.spd_inverse(S)
     try:
         U, lower = la.cho_factor(S, lower=False, check_finite=False)

@@ -111,7 +111,8 @@ def build_member_model(
     body = assemble_body(mesh, E, nu, clamped)
     teeth = tuple(range(sector.n_teeth)) if teeth is None else tuple(sorted(teeth))
     flanks = [f"flank_{side}_{t}" for t in teeth]
-    facets = zone_facets(sector, mesh, flanks)
+    per_tooth = [zone_facets(sector, mesh, [f]) for f in flanks]
+    facets = np.concatenate(per_tooth)
     dofs = _facet_dofs(body.basis, facets)
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
@@ -122,10 +123,24 @@ def build_member_model(
     }
     flank_dofs = dofs  # the cells load only these; the layer is only read
     layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
+    groups = None
     if layer_mm > 0.0:
-        layer_tets[_cached_layer_tets(mesh, facets, layer_mm, key)] = True
+        # the layer under each tooth is read only under the loads of that tooth's own cells
+        # (the hybrid's matching points; other pairs are read at the surface): one block each
+        groups = []
+        for i, fac in enumerate(per_tooth):
+            tets = _cached_layer_tets(mesh, fac, layer_mm, {**key, "tooth": i})
+            layer_tets[tets] = True
+            fd = _facet_dofs(body.basis, fac)
+            groups.append((fd, np.setdiff1d(body.basis.element_dofs[:, tets].ravel(), flank_dofs)))
         dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
-    op = candidate_operator(body, dofs, backend=backend, cache_key=key, load_dofs=flank_dofs)
+        reads = np.concatenate([g[1] for g in groups])
+        if np.unique(reads).size != reads.size:  # layers of two teeth meet: one block
+            log.info("%s: the layers below the loaded teeth meet; one operator block", name)
+            groups = None
+    op = candidate_operator(
+        body, dofs, backend=backend, cache_key=key, load_dofs=flank_dofs, groups=groups
+    )
     log.info(
         "%s: %d DOFs, %d candidate DOFs, operator in %.1f s (%s)",
         name,
