@@ -235,8 +235,15 @@ class FaceGearMember:
         return np.take_along_axis(cands, k[..., None], -1)[..., 0]
 
     def envelope(self, side: Side, t: ArrayLike, us: ArrayLike) -> Envelope:
-        """Engine output at shaper roll ``t`` and shaper axial position ``u_s``."""
+        """Engine output at shaper roll ``t`` and shaper axial position ``u_s``.
+
+        For γ = 90° the start ψ is the root of the equation of meshing (:meth:`psi_guess`): the
+        engine only has to confirm it, on a bracket of ±1e-4 rad scanned at 3 points instead of
+        ±0.05 rad at 17 (the flank evaluations of a sector mesh 6.2 → ~1.5 s, the same points)."""
         psi0 = self.psi_guess(side, t, us)
+        if abs(self.design.shaft_angle_deg - 90.0) < 1e-12:
+            return generate(self.shaper(side), self.motion(side), t, us, psi0,
+                            half_width=1e-4, n_scan=3)  # fmt: skip
         return generate(self.shaper(side), self.motion(side), t, us, psi0, half_width=0.05)
 
     def _solve(self, side: Side, h: Array, L: Array) -> tuple[Envelope, Array, Array]:
