@@ -1,4 +1,5 @@
-"""Figures and tables of docs/tca/README.md. Run: ``python docs/tca/make_figures.py``."""
+"""Figures and tables of docs/tca/README.md. Run: ``python docs/tca/make_figures.py [PART ...]``
+(parts: conventions, spur, face_gear, spiral_bevel; all by default)."""
 
 from __future__ import annotations
 
@@ -42,14 +43,25 @@ def face_gear() -> None:
     for dg in (-0.02, 0.0, 0.02):
         asm = face_gear_assembly(fg, InstallationErrors(dgamma_deg=dg), pin)
         res[f"Δγ = {dg:+.2f}°"] = run_tca(pin, fg, asm, TCAOptions(pinion_torque_Nm=350.14))
+    from fegear.tca import TCA, reference_phase
+    from fegear.tca.path import contact_path
+
+    paths = {}
+    for (lab, rr), dg in zip(res.items(), (-0.02, 0.0, 0.02), strict=True):
+        opt = TCAOptions(separation_grid=None)
+        asm = face_gear_assembly(fg, InstallationErrors(dgamma_deg=dg), pin)
+        asm = asm.with_phase2(reference_phase(pin, fg, asm, opt))
+        tca = TCA(pin, fg, asm, opt)
+        paths[lab] = contact_path(tca, tca.positions(rr.phi1, with_grids=False))
     bd = fg.boundaries()
     plot_paths(res, HERE / "face_gear_paths.png", "gear", bd, ("inner end", "outer end"),
-               title="seed face gear: contact paths on the face-gear flank")  # fmt: skip
+               title="seed face gear: contact paths on the face-gear flank (dashed: one pair)",
+               pair_paths={k: cp.gear_uv for k, cp in paths.items()})  # fmt: skip
     plot_te(res, HERE / "face_gear_te.png", "seed face gear: unloaded TE")
     plot_pattern(res["Δγ = +0.00°"], HERE / "face_gear_pattern.png", PINION_BD(pin))
     r = res["Δγ = +0.00°"]
     print(
-        "| φ1 (deg) | face-gear height u (mm) | radius L (mm) | F (N) | a (mm) | b (mm) | p0 (MPa) |"  # noqa: E501
+        "| φ1 (deg) | face-gear height z (mm) | radius L (mm) | F (N) | a (mm) | b (mm) | p0 (MPa) |"  # noqa: E501
     )
     print("|---|---|---|---|---|---|---|")
     for k, p in enumerate(r.positions):
@@ -57,14 +69,20 @@ def face_gear() -> None:
         if e is None or e.hertz is None:
             print(f"| {np.degrees(p.phi1):.2f} | — | — | — | line/no contact | | |")
             continue
+        z = float(fg.height(r.gear_uv[k, 0], r.gear_uv[k, 1]))
         print(
-            f"| {np.degrees(p.phi1):.2f} | {r.gear_uv[k, 0]:.3f} | {r.gear_uv[k, 1]:.2f} | "
+            f"| {np.degrees(p.phi1):.2f} | {z:.3f} | {r.gear_uv[k, 1]:.2f} | "
             f"{e.force_N:.0f} | {e.hertz.a_mm:.3f} | {e.hertz.b_mm:.4f} | {e.hertz.p0_MPa:.0f} |"
         )
     for lab, rr in res.items():
+        cp = paths[lab]
         print(lab, "TE median %.4f p-p %.4f arcsec, median L %.2f mm, edge positions %d" % (  # noqa: UP031
             np.median(rr.te_arcsec), rr.te_peak_to_peak_arcsec, np.median(rr.gear_uv[:, 1]),
             rr.edge.sum()))  # fmt: skip
+        space = np.linalg.norm(np.diff(cp.fixed_points, axis=0), axis=1).sum()
+        print(f"  contact ratio {cp.contact_ratio:.3f}, path {cp.length_mm:.2f} mm on the "
+              f"face-gear flank, {space:.2f} mm in space, from {cp.start_limit} to "
+              f"{cp.end_limit}")  # fmt: skip
 
 
 def spiral_bevel() -> None:
@@ -159,8 +177,12 @@ def PINION_BD(pin):  # noqa: N802
 
 
 if __name__ == "__main__":
+    import sys
+
     logging.basicConfig(level=logging.INFO)
-    plot_assembly_conventions(HERE / "assembly_conventions.png")
-    spur()
-    face_gear()
-    spiral_bevel()
+    which = sys.argv[1:] or ["conventions", "spur", "face_gear", "spiral_bevel"]
+    if "conventions" in which:
+        plot_assembly_conventions(HERE / "assembly_conventions.png")
+    for name in ("spur", "face_gear", "spiral_bevel"):
+        if name in which:
+            globals()[name]()

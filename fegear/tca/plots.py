@@ -53,12 +53,16 @@ def plot_paths(
     labels: Sequence[str] = ("inner", "outer"),
     ellipses: bool = True,
     title: str = "",
+    pair_paths: dict[str, np.ndarray] | None = None,
 ) -> Path:
     """Contact paths in flank coordinates (face width × profile) of ``member``.
 
     ``bounds`` (a :class:`FlankBoundaries`) draws the flank outline; ``labels`` name the face
     ends ``v_start`` / ``v_end`` (e.g. inner/outer, toe/heel). Ellipses: paint-thickness ellipses
     drawn as their projected major-axis extent along the path (a, to scale in ``v``).
+    ``pair_paths`` (same keys as ``results``): ``(n, 2)`` flank coordinates of one pair over its
+    whole contact interval (:func:`fegear.tca.path.contact_path`), drawn as a dashed line — where
+    two pairs touch at once the cycle's contact point shows only one of them.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -73,6 +77,9 @@ def plot_paths(
         e = r.edge & m
         if e.any():
             ax.plot(uv[e, 1], y(uv[e]), "x", ms=7, color=f"C{i}")
+        if pair_paths and label in pair_paths:
+            pp = np.asarray(pair_paths[label])
+            ax.plot(pp[:, 1], y(pp), "--", lw=1.5, color=f"C{i}")
         if ellipses:
             yy = y(uv)
             for k in np.nonzero(m)[0]:
