@@ -23,6 +23,7 @@ from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, Invo
 from fegear.mesh.sector import mesh_sizes, sector_mesh  # noqa: E402
 from fegear.mesh.sector_check import tooth_compliance  # noqa: E402
 from fegear.mesh.sector_geometry import (  # noqa: E402
+    fillet_distance,
     flank_distance,
     section_integral_volume,
     sector_frame,
@@ -82,6 +83,27 @@ def node_deviation(sm, fr) -> float:
     return worst
 
 
+def fillet_deviation(sm, fr) -> float | None:
+    """Max over all fillet/root nodes of (distance to the generated fillet and root, within the
+    node's section) / (mean length of the triangle edges at the node); None without a generated
+    fillet (root blend)."""
+    if not fr.has_fillet:
+        return None
+    worst = 0.0
+    p = sm.points
+    for j in range(sm.n_teeth):
+        tri = sm.boundaries[f"fillet_{j}"]
+        e = np.linalg.norm(p[tri] - p[np.roll(tri, 1, axis=1)], axis=-1).mean(axis=1)
+        acc, cnt = np.zeros(len(p)), np.zeros(len(p))
+        for c in range(3):
+            np.add.at(acc, tri[:, c], e)
+            np.add.at(cnt, tri[:, c], 1)
+        nodes = np.unique(tri)
+        d = fillet_distance(fr, j - sm.centre_tooth, p[nodes])
+        worst = max(worst, float(np.max(d / (acc[nodes] / cnt[nodes]))))
+    return worst
+
+
 def picture(sm, fr, path: Path) -> None:
     """Offscreen PNG of the sector surface coloured by the local element size (the refined
     contact zone shows as the dark, dense patch on the centre teeth's drive flanks), seen from
@@ -131,18 +153,22 @@ def main(max_level: int = 2) -> None:
                 break
             wall = time.perf_counter() - t
             dg = sm.diagnostics
+            fd = fillet_deviation(sm, fr)
+            fil = "blend" if fd is None else f"{100 * fd:.3f}"
             rows.append(
                 f"| {name} | {lv} | {mesh_sizes(fr.module, lv)[0]:.2f} | {wall:.1f} | "
                 f"{dg.get('mesh_s', 0):.1f} | {len(sm.tets)} | {p2_dofs(sm)} | "
                 f"{dg.get('min_sicn', 0):.3f} | {1e3 * dg.get('flank_cad_deviation_mm', 0):.2f} | "
-                f"{100 * node_deviation(sm, fr):.3f} | {100 * (sm.volume() / ref - 1):+.2f} |"
+                f"{100 * node_deviation(sm, fr):.3f} | {fil} | "
+                f"{100 * (sm.volume() / ref - 1):+.2f} |"
             )
             log.info(rows[-1])
             if lv == min(1, max_level):
                 picture(sm, fr, DOCS / f"{name}.png")
     print("| member | level | h_fine mm | total s | 3-D mesh s | tets | P2 DOFs | min SICN "
-          "| flank CAD dev µm | node dist / h % | vol. err % |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "| flank CAD dev µm | node dist / h % | fillet node dist / h % "
+          "| vol. err % |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     print("\n".join(rows))
 
     m = next(iter(members()))[1]
