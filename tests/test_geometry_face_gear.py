@@ -189,3 +189,13 @@ def test_fillet_is_mirrored_on_the_coast_side(seed):
     pc = seed.point_normal("coast", u, L)[0]
     # symmetry of tooth 0 about +x (round-off)
     np.testing.assert_allclose(pc * [1, -1, 1], pd, atol=1e-8)
+
+
+def test_flank_with_the_fillet_rows(seed):
+    fl = seed.flank("drive", 12, 5, include_fillet=True)
+    f = fl.u < 0
+    assert f.sum() == 3 and fl.u[0] == -1.0  # a quarter of the rows, from the root
+    z = fl.points[..., 2]
+    np.testing.assert_allclose(z[0], seed.root_height, atol=1e-9)  # the fillet starts on the root
+    assert np.all(np.diff(z, axis=0) > 0)  # and rises to the tip
+    assert np.isfinite(fl.kappa).all() and np.all(fl.meshing_residual[f] == 0)

@@ -54,7 +54,7 @@ from ..errors import DesignError, SolverError
 from .face_gear_fillet import FilletLimit, TipEdge
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, generate
 from .involute import InvoluteDesign, InvoluteMember
-from .surface import FlankBoundaries, FlankSurface, Side
+from .surface import FlankBoundaries, FlankSurface, Side, finite_difference_curvatures
 from .transforms import rot_y, rot_z, translation
 from .validation import validate_face_gear
 
@@ -415,16 +415,36 @@ class FaceGearMember:
         p[f], n[f] = self._fillet_points(side, u[f], v[f])
         return p, n
 
-    def flank(self, side: Side, nu: int = 11, nv: int = 21) -> FlankSurface:
-        """Working flank of tooth 0: fillet limit to tip plane (``u`` 0 → 1), inner to outer."""
+    def flank(
+        self, side: Side, nu: int = 11, nv: int = 21, include_fillet: bool = False
+    ) -> FlankSurface:
+        """Flank of tooth 0: the working surface from the fillet limit to the tip plane (``u``
+        0 → 1), inner to outer; with ``include_fillet`` a quarter of the ``u`` samples (at least
+        2) lie on the generated fillet (``u`` from −1). The fillet is the trace of the shaper's
+        tip edge, not an envelope: its meshing residual is reported as 0 and its curvatures are
+        central differences of :meth:`point_normal` (steps 1e-4 in ``u``, 1e-2 mm in ``v``)."""
         self.check_limits()
         bd = self.boundaries()
-        u = np.linspace(bd.u_fillet, bd.u_tip, nu)
+        nf = max(2, nu // 4) if include_fillet else 0
+        uw = np.linspace(bd.u_fillet, bd.u_tip, nu - nf)
         v = np.linspace(bd.v_start, bd.v_end, nv)
-        env = self._solve(side, self.height(u[:, None], v[None, :], side), v[None, :])[0]
+        env = self._solve(side, self.height(uw[:, None], v[None, :], side), v[None, :])[0]
         kappa, dirs = env.curvatures()
-        return FlankSurface(self.name, side, u, v, env.points, env.normals, kappa, dirs,
-                            env.residual, bd)  # fmt: skip
+        pts, nrm, res = env.points, env.normals, env.residual
+        u = uw
+        if nf:
+            uf = np.linspace(bd.u_root, bd.u_fillet, nf, endpoint=False)
+            U, V = np.broadcast_arrays(uf[:, None], v[None, :])
+            pf, nf_ = self.point_normal(side, U, V)
+            kf, df = finite_difference_curvatures(
+                lambda a, b: self.point_normal(side, a, b)[0],
+                np.clip(U, bd.u_root + 1e-4, bd.u_fillet - 1e-4), V, (1e-4, 1e-2), nf_,
+            )  # fmt: skip
+            u = np.concatenate([uf, uw])
+            pts, nrm = np.concatenate([pf, pts]), np.concatenate([nf_, nrm])
+            kappa, dirs = np.concatenate([kf, kappa]), np.concatenate([df, dirs])
+            res = np.concatenate([np.zeros(U.shape), res])
+        return FlankSurface(self.name, side, u, v, pts, nrm, kappa, dirs, res, bd)
 
     # ------------------------------------------------------------------ limits
     def _singular_point(self, side: Side, us: float) -> tuple[float, Array]:
