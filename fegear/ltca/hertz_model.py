@@ -211,8 +211,8 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
     if not near.any():
         near = r <= r.min() + 1e-12
     cells = take_cells(cells, np.flatnonzero(near))
-    # the compliance operators cover the flank facets of the sectors' contact zone only
-    # (fegear.ltca.model.zone_facets): a pair at the zone's fringe keeps the cells they cover
+    # the compliance operators cover the working flanks of the teeth in the sectors' contact
+    # zone only (fegear.ltca.model): a pair at the zone's fringe keeps the cells they cover
     covered = _covered(tca, pos, models, cells)
     note = ""
     if not covered.all():
@@ -284,8 +284,8 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
     if not pos.has_contact:
         return _no_contact(pos, "no contact: the flanks do not meet at this position")
     # Pairs farther from contact than the sectors' contact zone reaches get their law only if the
-    # solved lag closes them: the compliance operators cover the flank facets of the zone only
-    # (fegear.ltca.model.zone_facets), and a law's lumped compliance reads the FE at the pair's
+    # solved lag closes them: the compliance operators cover the flanks of the zone's teeth only
+    # (fegear.ltca.model), and a law's lumped compliance reads the FE at the pair's
     # closest point (FZG: pairs 2.8 and 6.4 mm from contact at their tips).
     reach = float(models.zone.gap_mm) if models.zone is not None else np.inf
     near = {gi for gi, g in enumerate(pos.grids) if _backlash(tca, pos, g) <= reach}

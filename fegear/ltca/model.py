@@ -111,7 +111,9 @@ def build_member_model(
     body = assemble_body(mesh, E, nu, clamped)
     teeth = tuple(range(sector.n_teeth)) if teeth is None else tuple(sorted(teeth))
     flanks = [f"flank_{side}_{t}" for t in teeth]
-    per_tooth = [zone_facets(sector, mesh, [f]) for f in flanks]
+    # the whole working flank of each tooth that can touch: a load that closes more of it than
+    # the TCA's zone (g_max grows with the lag) stays on the operator
+    per_tooth = [np.sort(mesh.boundaries[f]) for f in flanks]
     facets = np.concatenate(per_tooth)
     dofs = _facet_dofs(body.basis, facets)
     key = {
@@ -159,34 +161,6 @@ def build_member_model(
         layer_tets=layer_tets,
         teeth=teeth,
     )
-
-
-#: Flank facets within this many fine element sizes of the contact zone carry the operator.
-ZONE_MARGIN_ELEMENTS = 1.5
-
-
-def zone_facets(sector: SectorMesh, mesh, flanks: list[str]) -> np.ndarray:
-    """Indices (``mesh.facets`` numbering) of the facets of ``flanks`` where contact can happen:
-    those with a vertex within ``ZONE_MARGIN_ELEMENTS`` fine element sizes of the sector's zone
-    points (:attr:`SectorMesh.zone_points`); all of them if the sector has no zone points.
-
-    The dense operator costs the cube of its size, so only what a cycle can load is modelled:
-    on the seed face gear the zone covers 23-74 % of the working flank of each loaded tooth
-    (the patch is 35 mm long on a 89 mm face). A cell inside a zone box lies on a facet whose
-    vertices are within one fine element size of it, and the zone points cover the boxes half an
-    element apart: 1.5 element sizes hold every facet a cell in the zone can load.
-    """
-    facets = np.concatenate([mesh.boundaries[f] for f in flanks])
-    zp = sector.zone_points
-    if zp is None or len(zp) == 0:
-        return np.sort(facets)
-    from scipy.spatial import cKDTree
-
-    h = float(sector.parameters["h_fine_mm"])
-    verts = mesh.facets[:, facets]  # (3, nf)
-    d, _ = cKDTree(zp).query(mesh.p[:, verts.ravel()].T)
-    near = (d.reshape(verts.shape) <= ZONE_MARGIN_ELEMENTS * h).any(axis=0)
-    return np.sort(facets[near])
 
 
 def _facet_dofs(basis, facets: np.ndarray) -> np.ndarray:

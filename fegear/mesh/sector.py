@@ -59,7 +59,7 @@ import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 from typing import NamedTuple
@@ -153,10 +153,6 @@ class SectorMesh:
         Measured numbers: mesh time, minimum SICN, CAD volume, flank CAD deviation, …
     path
         The cached ``.msh`` file.
-    zone_points
-        ``(m, 3)`` points on the flanks covering the zone boxes about ``h_fine/2`` apart
-        (member frame, on their teeth), or None: where contact can happen, for the stages that
-        model only that (the compliance operator).
     """
 
     member: str
@@ -167,7 +163,6 @@ class SectorMesh:
     parameters: Mapping[str, object]
     diagnostics: Mapping[str, object] = field(default_factory=dict)
     path: Path | None = None
-    zone_points: Array | None = None
 
     @property
     def n_teeth(self) -> int:
@@ -647,12 +642,8 @@ def sector_mesh(
     public = {k: v for k, v in params.items() if k != "member"}
     public["member_name"] = getattr(member, "name", "")
     public["h_fine_mm"], public["h_coarse_mm"] = mesh_sizes(fr.module, level)
-    h_fine = public["h_fine_mm"]
-    return replace(
-        load_sector_mesh(path, member=getattr(member, "name", ""), family=fr.family,
-                         parameters=public, diagnostics=diag),
-        zone_points=_zone_points(fr, zone, 0.5 * h_fine, n_teeth),
-    )  # fmt: skip
+    return load_sector_mesh(path, member=getattr(member, "name", ""), family=fr.family,
+                            parameters=public, diagnostics=diag)  # fmt: skip
 
 
 def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray[np.int64]]]:
