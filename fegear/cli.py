@@ -217,6 +217,13 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             )
     else:
         say(f"    unloaded TE p-p {_value(rep.te_pp_unloaded_arcsec, '.2f', 'arcsec')} (TCA only)")
+    cp = run.engagement.path if run.engagement is not None else None
+    if cp is not None:
+        say(
+            f"    unloaded contact ratio {cp.contact_ratio:.3f}: one pair's path "
+            f"{cp.length_mm:.1f} mm on the {run.pair.gear.name.replace('_', '-')} flank, from "
+            f"{cp.start_limit.replace(':', ' ')} to {cp.end_limit.replace(':', ' ')}"
+        )
     for w in rep.warnings:
         warn(w)
     n_other = sum(bool(p.warnings) for p in run.cycle.positions) if run.cycle is not None else 0

@@ -436,6 +436,28 @@ def test_face_gear_case_smoke(tmp_path, path):
     assert c["positions_without_contact"] == 0
 
 
+def test_face_gear_tca_reports_the_whole_path(tmp_path):
+    """Seed face gear, ``--fidelity tca``: on the whole generated flank one pair's contact runs
+    from the face-gear tip to the pinion tip, never onto the face gear's flank bottom (its fillet
+    limit), with a contact ratio above 1; ``summary.json`` says so (issue 20)."""
+    out = tmp_path / "out"
+    case = REPO / "cases" / "face_gear_nominal.toml"
+    assert main(["run", str(case), "--fidelity", "tca", "--out", str(out), "-q"]) == 0
+    doc = json.loads((out / "summary.json").read_text())
+    c = doc["cycle"]
+    assert c["path_ends"] == ["gear:tip", "pinion:tip"]
+    # measured 1.554 (ε p_b = 28.10 mm in space) and 13.11 mm on the face-gear flank
+    assert 1.5 < c["contact_ratio_unloaded"] < 1.6
+    assert 12.5 < c["path_length_mm"] < 13.7
+    p_b = math.pi * 6.35 * math.cos(math.radians(25.0))
+    # the involute pinion unrolls the path in space along its plane of action: ε p_b
+    assert c["path_length_in_space_mm"] == pytest.approx(
+        c["contact_ratio_unloaded"] * p_b, rel=1e-4
+    )
+    edges = {e for p in doc["positions"] for q in p["pairs"] for e in q["edge"].split(",") if e}
+    assert "gear:root" not in edges  # the face-gear fillet limit is never touched
+
+
 @pytest.mark.slow
 def test_no_argument_main_job_writes_all_outputs(tmp_path, monkeypatch):
     """``fegear run`` with no case: the seed face gear, hybrid level 0, 25 positions."""

@@ -89,6 +89,36 @@ def test_contact_ratio_equals_transverse_contact_ratio(conjugate):
     assert abs(eps - analytic) < 1e-3, (eps, analytic)
 
 
+def test_contact_path_of_one_pair_gives_the_transverse_contact_ratio(conjugate):
+    """:func:`fegear.tca.path.contact_path` (pair 0 over its whole interval, from the cycle's
+    three pairs, ends bisected) against the closed-form ε_α; the pair enters at the gear tip and
+    leaves at the pinion tip; in space the path is the line of action, ε_α p_b long."""
+    from fegear.tca import TCA
+    from fegear.tca.path import contact_path
+
+    asm, _ = conjugate
+    opt = TCAOptions(n_positions=25, separation_grid=None)
+    asm = asm.with_phase2(reference_phase(PINION, GEAR, asm, opt))
+    tca = TCA(PINION, GEAR, asm, opt)
+    phi1 = -np.pi / 16 + 2 * np.pi / 16 * np.arange(25) / 25
+    cp = contact_path(tca, tca.positions(phi1, with_grids=False))
+    aw = _alpha_w(asm)
+    pb = math.pi * 4.5 * math.cos(math.radians(20))
+    analytic = (
+        math.sqrt(PINION.r_a**2 - PINION.r_b**2)
+        + math.sqrt(GEAR.r_a**2 - GEAR.r_b**2)
+        - asm.axes_distance() * math.sin(aw)
+    ) / pb
+    # both ends bisected by 4 rounds of 9 points from a 1/25 cycle step: ~1.5e-6 rad at each
+    # end of a 0.39 rad pitch (measured 7.5e-6 in ε)
+    assert abs(cp.contact_ratio - analytic) < 2e-5, (cp.contact_ratio, analytic)
+    assert cp.start_limit.startswith("gear:tip") and cp.end_limit.startswith("pinion:tip"), cp
+    space = np.linalg.norm(cp.fixed_points[-1] - cp.fixed_points[0])
+    # the contact points of a line contact are the line's centres, on the line of action, which
+    # the pinion's base circle unrolls: r_b1 Δφ1 (the TCA's points to ~1e-6 mm)
+    assert abs(space - PINION.r_b * (cp.phi_end - cp.phi_start)) < 1e-5, space
+
+
 @pytest.mark.parametrize("kind", ["delta", "beta"])
 def test_axis_parallelism_error(kind):
     f = 0.02  # mm over the 14 mm face: a coarse ISO 1328 class

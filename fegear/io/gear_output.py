@@ -12,7 +12,12 @@ Files written to the output folder (each one atomically: complete or absent):
   (``p_max_edge_at``: position, pair, edges named), and ``null`` with a ``*_reason`` where
   nothing physical can be reported, never 0. The engagement checks made before the analysis:
   ``cycle.tip_clearance_mm``, ``cycle.unloaded_interior_contact_fraction`` (the contact ratio
-  when below 1), ``cycle.positions_without_unloaded_contact``. Keys other tools rely on:
+  when below 1), ``cycle.positions_without_unloaded_contact``; one pair's unloaded contact over
+  its whole contact interval (:func:`fegear.tca.path.contact_path`):
+  ``cycle.contact_ratio_unloaded`` (the interval over the angular pitch),
+  ``cycle.path_length_mm`` (on the gear flank), ``cycle.path_length_in_space_mm``,
+  ``cycle.path_ends`` (what ends it: ``"gear:tip"``, ``"pinion:tip"``, ``"transfer"``, …),
+  ``cycle.path_pinion_angles_deg``. Keys other tools rely on:
   ``cycle.te_pp_unloaded_arcsec``, ``cycle.te_pp_loaded_arcsec``,
   ``cycle.contact_ratio_loaded``, ``cycle.p_max_MPa``, ``positions[i].pinion_angle_deg``,
   ``positions[i].te_loaded_arcsec``, ``positions[i].pairs[j].load_share``,
@@ -105,6 +110,29 @@ def _pair_row(q, k: int) -> dict[str, Any]:
         "resolved": bool(q.resolved),
         "in_contact": loaded,
         "contact_point_mm": [float(x) for x in q.contact_point] if loaded else None,
+    }
+
+
+def _path_keys(cp) -> dict[str, object]:
+    """``cycle`` keys of one pair's unloaded contact over its whole contact interval
+    (:class:`fegear.tca.path.ContactPath`), null with a reason where no pair has interior
+    contact."""
+    if cp is None:
+        why = "no pair is in contact inside both working surfaces at any position"
+        return {
+            "contact_ratio_unloaded": None,
+            "path_length_mm": None,
+            "path_length_in_space_mm": None,
+            "path_ends": None,
+            "path_reason": why,
+        }
+    space = float(np.linalg.norm(np.diff(cp.fixed_points, axis=0), axis=1).sum())
+    return {
+        "contact_ratio_unloaded": _f(cp.contact_ratio),
+        "path_length_mm": _f(cp.length_mm),
+        "path_length_in_space_mm": _f(space),
+        "path_ends": [cp.start_limit, cp.end_limit],
+        "path_pinion_angles_deg": [math.degrees(cp.phi_start), math.degrees(cp.phi_end)],
     }
 
 
@@ -204,6 +232,7 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
             "contact_ratio_unloaded_below_1": _f_or_none(eng.contact_ratio_below_one),
             "handover_missed_by_positions": bool(eng.missed_handover),
             "positions_without_unloaded_contact": list(eng.lost),
+            **_path_keys(eng.path),
         }
     if run.cycle is not None:
         c = run.cycle

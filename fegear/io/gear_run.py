@@ -113,6 +113,10 @@ class Engagement:
         Tip-to-root clearances (:class:`fegear.tca.engagement.Clearance`).
     handover
         Interior contact over the cycle (:class:`fegear.tca.engagement.Handover`).
+    path
+        One pair's unloaded contact over its whole contact interval
+        (:class:`fegear.tca.path.ContactPath`: contact ratio, path length, what ends it), or
+        None where no pair has interior contact.
     phi1
         ``(n,)`` rad, the positions of the run.
     has_contact
@@ -134,6 +138,7 @@ class Engagement:
     missed_handover: bool
     errors: tuple[tuple[str, float], ...]
     warnings: tuple[str, ...]
+    path: Any = None
 
     @property
     def contact_ratio_below_one(self) -> float | None:
@@ -204,6 +209,7 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
         errors that separate them).
     """
     from fegear.tca.engagement import cached_handover
+    from fegear.tca.path import cached_contact_path
 
     errs = tuple(error_fields(case))
     has = np.array([p.has_contact for p in positions], dtype=bool)
@@ -220,6 +226,7 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
             f"cycle; the teeth are separated by {_fields_text(errs)}",
         )
     h = cached_handover(pair.pinion, pair.gear, pair.assembly, tca.opt, tca)
+    path = cached_contact_path(pair.pinion, pair.gear, pair.assembly, tca.opt, tca, positions)
     warnings = []
     lost = np.flatnonzero(~has)
     if lost.size:
@@ -254,6 +261,7 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
         missed_handover=missed,
         errors=errs,
         warnings=tuple(warnings),
+        path=path,
     )
 
 

@@ -5,8 +5,11 @@ All teeth of a member are alike, so pair ``m`` at pinion angle ``φ1`` is pair 0
 tooth ``j = −s2 m`` at ``s2(φ2 − m τ2)``, ``φ2 = (N1/N2) φ1``): the positions of one cycle with
 pairs ``m ∈ {−1, 0, 1}`` sample pair 0 over three cycles. Pair 0 is *in contact* at ``ψ`` when its
 closing rotation is the smallest of all pairs (within ``tol_rad``: conjugate pairs tie) and its
-contact point is inside both working surfaces (no edge: a pair that touches only with a flank
-edge is bridging a gap in the meshing, not carrying it with its flanks). The contact interval
+contact point is on neither the tip nor the root (fillet-limit) boundary of either working
+surface: a pair that touches only with a tip edge is bridging a gap in the meshing, not carrying
+it with its flanks. A face end does not end the interval (a line contact always reaches it, a
+localized one runs along it under misalignment; it stays flagged as an edge contact), as in
+:func:`fegear.tca.engagement.handover`. The contact interval
 ``[ψ_in, ψ_out]`` is the run of such samples, its ends refined by bisection on the same predicate
 (batches of 8 positions per round, 4 rounds: a resolution of ``τ1/n_positions/9⁴``). Then
 
@@ -29,7 +32,7 @@ from ..geometry.transforms import apply_points
 from .core import TCA
 from .results import PositionResult
 
-__all__ = ["ContactPath", "contact_path"]
+__all__ = ["ContactPath", "cached_contact_path", "contact_path"]
 
 Array = NDArray[np.float64]
 
@@ -92,7 +95,9 @@ def _samples(tca: TCA, pos: PositionResult, tol_rad: float) -> list[_Sample]:
     out = []
     for i in range(len(m)):
         ok = bool(pos.has_contact and pos.pair_valid[i])
-        inside = ok and pos.backlash_rad[i] <= tol_rad and not pos.edge[i]
+        tags = [t for t in pos.edge[i].split(",") if t] if ok else []
+        profile = any(t.endswith(":tip") or t.endswith(":root") for t in tags)
+        inside = ok and pos.backlash_rad[i] <= tol_rad and not profile
         out.append(
             _Sample(
                 psi=float(pos.phi1 - m[i] * tau),
@@ -201,3 +206,54 @@ def contact_path(
         start_limit=start_limit,
         end_limit=end_limit,
     )
+
+
+def cached_contact_path(pinion, gear, assembly, options, tca: TCA, positions) -> ContactPath | None:
+    """:func:`contact_path` of the pair, read from the artefact cache when the same pair
+    (members, assembly with its errors, TCA options, the positions' angles) was traced before
+    (seed face gear ~1.8 s otherwise)."""
+    from fegear.mesh.cache import cached_file
+
+    from .cached import _assembly_key, _source_hash
+
+    params = {
+        "pinion": repr(pinion),
+        "gear": repr(gear),
+        "assembly": _assembly_key(assembly),
+        "options": repr(options),
+        "phi1": np.array([p.phi1 for p in positions], dtype=float),
+        "source": _source_hash(),
+    }
+    box: dict[str, ContactPath | None] = {}
+    arrays = ("phi", "gear_points", "pinion_points", "fixed_points", "gear_uv", "pinion_uv")
+
+    def build(path) -> None:
+        cp = box["cp"] = contact_path(tca, positions)
+        with open(path, "wb") as fh:
+            if cp is None:
+                np.savez(fh, none=np.array(True))
+            else:
+                np.savez(
+                    fh,
+                    none=np.array(False),
+                    scalars=np.array([cp.phi_start, cp.phi_end, cp.contact_ratio, cp.length_mm]),
+                    limits=np.array([cp.start_limit, cp.end_limit]),
+                    **{k: getattr(cp, k) for k in arrays},
+                )
+
+    path, hit = cached_file("contact_path", params, ".npz", build)
+    if not hit:
+        return box["cp"]
+    with np.load(path) as z:
+        if bool(z["none"]):
+            return None
+        s, lim = z["scalars"], z["limits"]
+        return ContactPath(
+            phi_start=float(s[0]),
+            phi_end=float(s[1]),
+            contact_ratio=float(s[2]),
+            length_mm=float(s[3]),
+            start_limit=str(lim[0]),
+            end_limit=str(lim[1]),
+            **{k: z[k] for k in arrays},
+        )
