@@ -173,3 +173,51 @@ def test_no_contact_is_a_flag_not_a_crash(pair):
     for a in (r.te_arcsec, r.pair_te_arcsec, r.gear_uv, r.pinion_uv, r.backlash_mm):
         assert np.all(np.isfinite(a)) and not np.any(a)
     assert all(p.ellipse is None and p.contact_pair == -1 for p in r.positions)
+
+
+@pytest.fixture(scope="module")
+def nominal_path(pair):
+    """Pair 0's unloaded contact interval (tca.path) from 13 positions of the error-free pair."""
+    from fegear.tca import TCA, reference_phase
+    from fegear.tca.path import contact_path
+
+    opt = TCAOptions(separation_grid=None)
+    asm = spiral_bevel_assembly(pair, SIDE)
+    asm = asm.with_phase2(reference_phase(pair.pinion, pair.gear, asm, opt))
+    tca = TCA(pair.pinion, pair.gear, asm, opt)
+    pos = tca.positions(cycle_angles(pair.blank.n1, 13), with_grids=False)
+    return tca, pos, contact_path(tca, pos)
+
+
+def test_contact_interval_is_one_pitch_between_transfer_points(pair, nominal_path):
+    """The predesigned parabolic TE hands the load over where consecutive pairs' parabolas cross
+    (the transfer points at ±π/N1): the interval is one angular pitch, ended by transfers at both
+    ends, not by a flank edge; the path never reaches the fillet limit (on the whole generated
+    flank the gear's u = 0 lies 0.07-0.36 mm below the pinion's face cone)."""
+    tca, pos, cp = nominal_path
+    assert cp.start_limit == "transfer" and cp.end_limit == "transfer", cp
+    # 13 positions, 4 bisection rounds of 8 per end: each end to τ1/13/9⁴ = 1.2e-5 of a pitch,
+    # and the two pairs tie (within tol_rad = 1e-9 rad, on a TE difference of slope ~3e-4) over
+    # ~6e-6 of a pitch: 3e-5 (measured 0.999987)
+    assert abs(cp.contact_ratio - 1.0) < 3e-5, cp.contact_ratio
+    # measured 15.38 mm on the gear flank, toe -> heel (longitudinal path)
+    assert 14.0 < cp.length_mm < 17.0, cp.length_mm
+    for uv in (cp.gear_uv, cp.pinion_uv):
+        assert np.all((uv[:, 0] > 0.05) & (uv[:, 0] < 0.95)), uv[:, 0]
+    assert not any("root" in e for p in pos for e in p.edge)
+
+
+def test_contact_on_the_pinion_tip_is_the_pinion_tip_edge(pair):
+    """The pinion pulled back 2.2 mm along its axis moves the pattern down the gear flank until
+    the pinion's tip runs on it: that contact is the pinion's tip edge ("pinion:tip"), on the
+    gear's working surface (u > 0), never an edge at the gear's flank bottom."""
+    asm = spiral_bevel_assembly(pair, SIDE, InstallationErrors(dA1_mm=-2.2))
+    opt = TCAOptions(separation_grid=None)
+    r = run_tca(pair.pinion, pair.gear, asm, opt, phi1=np.radians([-7.5, -5.0, -2.5, 0.0]))
+    cp = [p.contact_pair for p in r.positions]
+    tags = [p.edge[k] for p, k in zip(r.positions, cp, strict=True)]
+    # measured: the first three positions on the pinion tip (u1 = 1), the last inside
+    assert sum("pinion:tip" in t for t in tags) >= 2, tags
+    assert not any("gear:root" in t for t in tags), tags
+    gu = np.array([p.gear_uv[k][0] for p, k in zip(r.positions, cp, strict=True)])
+    assert np.all(gu > 0.1), gu

@@ -23,34 +23,59 @@ Conventions
 - Drive flank = concave gear side (outside blade) / convex pinion side (inside blade); coast =
   convex gear / concave pinion. The gear is right-hand, the pinion left-hand.
 - Flank parameters: ``v = L`` the cone distance (mm), toe ``A0 − F`` → heel ``A0``; ``u`` the
-  fraction of the working flank height at that L, 0 at the fillet limit (the mate's face cone
-  + clearance, the lowest point that can be in contact; the fillet is not modelled) and 1 at the
-  face cone. ``(L, h)`` coordinates are defined in :mod:`.spiral_bevel_settings`.
+  fraction of the working flank height at that L, 0 on the fillet limit ``h_fl(L)`` (where the
+  blade meets its edge radius: a curve over the face, :meth:`SpiralBevelMember.fillet_height`)
+  and 1 on the face cone; ``u ∈ [−1, 0)`` is the generated fillet (the envelope of the blade's
+  edge radius, a torus of the cutter), ``−1`` where it touches the root cone. ``(L, h)``
+  coordinates are defined in :mod:`.spiral_bevel_settings`.
+
+Cutter tip, fillet limit and fillet (Litvin & Fuentes 2004 §21.2; Litvin & Zhang 1991;
+Argyris, Fuentes & Litvin 2002 §2)
+-------------------------------------------------------------------------------------------
+The blade of each flank's head cutter ends in an edge radius ``ρ_f``
+(:class:`~.spiral_bevel_settings.EdgeRadius`, :func:`~.spiral_bevel_settings.blade_tip`):
+an arc tangent to the blade at ``s = s_b`` and to the cutter's point plane, the plane normal to
+the cutter axis that touches the blank's root cone (:func:`~.spiral_bevel_settings.point_plane`;
+under the cradle motion it turns in itself and, with the blank's roll, sweeps exactly the root
+cone). The blade and the arc share the circle ``s = s_b`` of the tool and its normal, so their
+envelopes under the same generating motion ``M(ψ)`` share the curve it generates: the *fillet
+limit*, the points of the blade envelope with ``s = s_b``. At cone distance ``L`` it is found by
+Newton on the cutter angle ``θ`` (``∂L/∂θ = ∇L · r_θ`` with the engine's implicit-function
+tangent ``r_θ``); its height ``h_fl(L)`` is tabulated once per flank as a cubic spline (nodes
+0.5 mm apart, 1e-10 mm from the exact curve, tested). Below it the flank is the envelope of the
+torus: at fillet coordinate ``u`` the arc angle is ``ϑ = (1 + u) ϑ_b`` (``ϑ = 0`` on the point
+plane, ``ϑ_b`` at the blade) and ``θ`` solves ``L(θ) = L`` the same way; ``ϑ = 0`` generates
+the root cone (the point plane's own envelope), tangentially.
 - Mesh frame (:meth:`SpiralBevelPair.mesh_placement`): apex at the origin, pinion axis +z_f,
   gear axis +x_f (Σ = 90°), common pitch generatrix in the x_f z_f plane.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import CubicSpline
 
-from ..errors import InputError, SolverError
+from ..errors import DesignError, InputError, SolverError
 from .generation import Envelope, generate
 from .spiral_bevel_settings import (
     ARCSEC,
+    EdgeRadius,
     MachineSettings,
     SpiralBevelBlank,
     SpiralBevelSettings,
     SynthesisReport,
     SynthesisTargets,
+    blade_tip,
     head_cutter,
     machine_motion,
     mesh_transforms,
+    point_plane,
     synthesize,
 )
 from .surface import FlankBoundaries, FlankSurface, Side
@@ -65,7 +90,9 @@ __all__ = [
     "SpiralBevelMember",
     "SpiralBevelPair",
     "FlankEvaluation",
+    "FilletLimit",
     "NativeFlank",
+    "NativeFillet",
     "transmission_error",
 ]
 
@@ -113,13 +140,35 @@ def _cone_coords(p: Array, gamma: float) -> tuple[Array, Array, Array, Array]:
 
 
 @dataclass(frozen=True)
+class FilletLimit:
+    """The fillet limit of one flank at cone distances ``L``; arrays ``(...)``/``(..., 3)``.
+
+    Attributes
+    ----------
+    theta, psi
+        Cutter angle and cradle angle (rad) generating the point from the blade's end ``s_b``.
+    points, normals
+        Member frame (mm) and outward unit normals of the blade envelope.
+    height
+        ``h`` above the pitch cone (mm).
+    """
+
+    theta: Array
+    psi: Array
+    points: Array
+    normals: Array
+    height: Array
+
+
+@dataclass(frozen=True)
 class SpiralBevelMember:
     """One member (pinion or gear) of a spiral bevel pair; implements ``GeneratedMember``.
 
     Build it through :class:`SpiralBevelPair`. ``point_normal``/``evaluate`` solve, for each
-    ``(u, v)``, the cutter parameters ``(s, θ)`` whose generated point has cone distance ``v`` and
-    height ``h(u, v)`` (2-D Newton on the engine's implicit-function derivatives; the engine
-    solves the equation of meshing for ψ inside).
+    working ``(u >= 0, v)``, the blade parameters ``(s, θ)`` whose generated point has cone
+    distance ``v`` and height ``h(u, v)`` (2-D Newton on the engine's implicit-function
+    derivatives; the engine solves the equation of meshing for ψ inside); for ``u < 0`` the
+    edge-radius angle ``ϑ = (1 + u) ϑ_b`` and the θ giving cone distance ``v`` (the fillet).
     """
 
     name: str
@@ -148,28 +197,201 @@ class SpiralBevelMember:
             raise InputError(f"{self.name}.side", side, "'drive' or 'coast'")
         return self.drive if side == "drive" else self.coast
 
-    def boundaries(self) -> FlankBoundaries:
+    def boundaries(self, side: Side = "drive") -> FlankBoundaries:
+        """Flank coordinates: ``v`` the cone distance ``L`` (mm), toe → heel; ``u`` the fraction
+        of the working height at that L, 0 on the fillet limit ``h_fl(L)`` (a curve over the
+        face, :meth:`fillet_height`), 1 on the face cone; ``u ∈ [−1, 0)`` the generated fillet
+        (−1 on the root cone). The working surface is exactly ``[0, 1] × [toe, heel]`` for every
+        consumer; ``height`` gives the curves back in mm for ``side`` (the limits are the same
+        numbers for both sides, the curves they stand for are each side's own)."""
         A0 = self.blank.outer_cone_distance
         return FlankBoundaries(
-            u_root=0.0,
+            u_root=-1.0,
             u_fillet=0.0,
             u_tip=1.0,
             v_start=A0 - self.blank.face_width_mm,
             v_end=A0,
-            u_name="fraction of the working height: 0 fillet limit, 1 face cone",
+            u_name="fraction of the working height: 0 fillet limit, 1 face cone (-1 root cone)",
             v_name="cone distance L (mm), toe -> heel",
+            height=functools.partial(self.height, side=self.settings(side).side),
+            height_name="height h above the pitch cone (mm)",
         )
 
-    def height(self, u: ArrayLike, v: ArrayLike) -> Array:
-        """Height ``h`` above the pitch cone (mm) of flank parameters ``(u, v)``."""
-        h_f, h_a = self.blank.flank_heights(self.index, v)
-        return h_f + np.asarray(u, dtype=float) * (h_a - h_f)
+    # ------------------------------------------------------------------ cutter tip and limits
+    def edge_tool(self, side: Side) -> EdgeRadius:
+        """The edge radius of the ``side`` blade, placed on the point plane that cuts this
+        member's root cone (:func:`~.spiral_bevel_settings.blade_tip`, cached)."""
+        key = ("edge", side)
+        if key not in self._cache:
+            ms = self.settings(side)
+            cutter = self._tools(side)[0]
+            zp = point_plane(self.blank, self.index, ms)
+            self._cache[key] = blade_tip(cutter, ms.edge_radius_mm, zp)
+        return self._cache[key]
 
-    def mean_parameters(self) -> tuple[float, float]:
-        """``(u, v)`` of the mean point (pitch cone, mean cone distance)."""
+    def _theta_solve(
+        self, side: Side, tool, w: Array, L: Array, theta0: Array, psi0: Array,
+        tol: float = 1e-12,
+    ) -> tuple[Envelope, Array]:  # fmt: skip
+        """Envelope of ``tool`` at profile parameter ``w`` and the cutter angle θ whose
+        generated point has cone distance ``L``: Newton on θ with ``∂L/∂θ = ∇L · r_θ`` (the
+        engine's implicit-function tangent), ψ continued from ``psi0``; stops at ``tol`` mm."""
+        mot = self._tools(side)[1]
+        g = self.pitch_angle
+        w, L, th, psi = (np.array(a, dtype=float) for a in np.broadcast_arrays(w, L, theta0, psi0))
+        hw, err = 0.6, np.inf
+        for _ in range(40):
+            env = generate(tool, mot, w, th, psi, half_width=hw)
+            Lp, _, gL, _ = _cone_coords(env.points, g)
+            F = Lp - L
+            err = float(np.max(np.abs(F))) if F.size else 0.0
+            if err < tol:
+                return env, th
+            th = th - np.clip(F / np.sum(gL * env.r_t, -1), -0.05, 0.05)
+            psi, hw = env.psi, 0.15
+        raise SolverError(
+            f"spiral bevel {self.name} {side}: cone distance not reached on the cutter's "
+            f"{type(tool).__name__} (max |dL| = {err:.2e} mm)"
+        )
+
+    def _theta_predictor(self, side: Side, s: Array, L: Array) -> Array:
+        """Linear predictor of θ at blade parameter ``s`` and cone distance ``L`` from the mean
+        point (``s = θ = ψ = 0``)."""
+        tool, mot = self._tools(side)
+        e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        L0, _, gL0, _ = _cone_coords(e0.points, self.pitch_angle)
+        return (np.asarray(L, float) - L0 - (gL0 @ e0.r_u) * np.asarray(s, float)) / (gL0 @ e0.r_t)
+
+    def fillet_limit(self, side: Side, L: ArrayLike, tol: float = 1e-12) -> FilletLimit:
+        """The exact fillet limit at cone distances ``L`` (mm): the point of the blade
+        envelope generated by the blade's end ``s = s_b`` (where the edge radius begins), by
+        Newton on the cutter angle (:meth:`_theta_solve`, ``tol`` mm)."""
+        L = np.asarray(L, float)
+        sb = np.full(L.shape, self.edge_tool(side).s_blade)
+        th0 = self._theta_predictor(side, sb, L)
+        env, th = self._theta_solve(side, self._tools(side)[0], sb, L, th0, np.zeros(L.shape), tol)
+        h = _cone_coords(env.points, self.pitch_angle)[1]
+        return FilletLimit(th, env.psi, env.points, env.normals, h)
+
+    def _limit_table(self, side: Side) -> tuple[CubicSpline, CubicSpline, CubicSpline]:
+        """Cubic splines over the cone distance of the fillet-limit height ``h_fl(L)``, its
+        cutter angle ``θ_fl(L)`` and generating angle ``ψ_fl(L)``: 0.5 mm apart from 0.4 F
+        inside the toe to 0.2 F past the heel (the sector loft reaches 0.04 F past both ends).
+        The curve is smooth and nearly straight: the spline is within ~1e-10 mm of the exact
+        limit (tested)."""
+        key = ("limit", side)
+        if key not in self._cache:
+            A0, F = self.blank.outer_cone_distance, self.blank.face_width_mm
+            n = int(math.ceil(1.6 * F / 0.5)) + 1
+            L = np.linspace(A0 - 1.4 * F, A0 + 0.2 * F, n)
+            lim = self.fillet_limit(side, L)
+            self._cache[key] = (
+                CubicSpline(L, lim.height),
+                CubicSpline(L, lim.theta),
+                CubicSpline(L, lim.psi),
+            )
+        return self._cache[key]
+
+    def fillet_height(self, L: ArrayLike, side: Side = "drive") -> Array:
+        """Height ``h_fl`` (mm, above the pitch cone) of the fillet limit at cone distances
+        ``L``: the lower limit of the working surface, a curve over the face."""
+        return self._limit_table(side)[0](np.asarray(L, float))
+
+    def height(self, u: ArrayLike, v: ArrayLike, side: Side = "drive") -> Array:
+        """Height ``h`` above the pitch cone (mm) of flank coordinates ``(u, v)``:
+        ``h_fl + u (h_a − h_fl)`` on the working surface, the generated fillet's below."""
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        h_fl = self.fillet_height(v, side)
+        h_a = self.blank.flank_heights(self.index, v)[1]
+        h = h_fl + np.maximum(u, 0.0) * (h_a - h_fl)
+        f = u < 0
+        if np.any(f):
+            h = np.array(h, dtype=float)
+            p = self.native_fillet(side).evaluate(*self.native_fillet(side).native(u[f], v[f]))[0]
+            h[f] = _cone_coords(p, self.pitch_angle)[1]
+        return h
+
+    def working_u(self, h: ArrayLike, L: ArrayLike, side: Side = "drive") -> Array:
+        """Flank coordinate ``u`` of the working-surface point at height ``h`` and cone distance
+        ``L``: ``(h − h_fl(L)) / (h_a(L) − h_fl(L))``."""
+        L = np.asarray(L, float)
+        h_fl = self.fillet_height(L, side)
+        h_a = self.blank.flank_heights(self.index, L)[1]
+        return (np.asarray(h, float) - h_fl) / (h_a - h_fl)
+
+    def mean_parameters(self, side: Side = "drive") -> tuple[float, float]:
+        """``(u, v)`` of the mean point of the ``side`` flank (pitch cone, mean cone distance)."""
         rm = self.blank.mean_cone_distance
-        h_f, h_a = self.blank.flank_heights(self.index, rm)
-        return float(-h_f / (h_a - h_f)), rm
+        return float(self.working_u(0.0, rm, side)), rm
+
+    def _fillet_solve(self, side: Side, u: Array, L: Array) -> tuple[Envelope, Array, Array]:
+        """Exact fillet points (engine) at fillet coordinates ``u ∈ [−1, 0]``, cone distances
+        ``L``: the envelope of the edge radius at ``ϑ = (1 + u) ϑ_b`` (:meth:`_theta_solve`,
+        from the fillet limit's θ and ψ). Returns the envelope, ``ϑ`` and ``θ``."""
+        tool = self.edge_tool(side)
+        u, L = np.broadcast_arrays(np.asarray(u, float), np.asarray(L, float))
+        w = (1.0 + u) * tool.theta_blade
+        _, s_th, s_psi = self._limit_table(side)
+        env, th = self._theta_solve(side, tool, w, L, s_th(L), s_psi(L))
+        return env, w, th
+
+    def root_land(self, n_L: int = 9) -> tuple[Array, Array]:
+        """``(L, land)``: ``n_L`` cone distances toe → heel (mm) and the root land there (mm):
+        the arc of the root circle between the bottoms (``u = −1``, on the root cone) of the two
+        fillets of a tooth space (the ``+θ`` flank of a tooth and the ``−θ`` flank of the next).
+        Negative where the fillets overlap. Cached."""
+        key = ("root_land", n_L)
+        if key not in self._cache:
+            A0, F = self.blank.outer_cone_distance, self.blank.face_width_mm
+            L = np.linspace(A0 - F, A0, n_L)
+            phi = {}
+            for side in ("drive", "coast"):
+                nf = self.native_fillet(side)
+                p = nf.evaluate(*nf.native(-np.ones_like(L), L))[0]
+                phi[side] = np.arctan2(p[:, 1], p[:, 0])
+            plus, minus = ("drive", "coast")
+            if phi["drive"][0] < phi["coast"][0]:
+                plus, minus = minus, plus
+            g = self.pitch_angle
+            rho_root = L * math.sin(g) + self.blank.root_height(self.index, L) * math.cos(g)
+            self._cache[key] = (L, (phi[minus] + self.tooth_angle - phi[plus]) * rho_root)
+        return self._cache[key]
+
+    def check_fillets(self) -> None:
+        """Refuse an edge radius the blades cannot carry.
+
+        (1) The fillet limit must lie below the mean contact point (``h_fl(R_m) < 0``; else the
+        designed contact is on the fillet). (2) The fillets of the two flanks of a tooth space
+        must not overlap: the :meth:`root_land` must stay positive from toe to heel. Each edge
+        radius takes about ``ρ_f (1 − sin α)/cos α`` of the root (normal section) from its
+        blade's sharp corner; with a larger radius than the point width of the space carries,
+        the second fillet would cut into the first and neither would be the envelope modelled.
+
+        Raises :class:`~fegear.errors.DesignError` naming ``spiral_bevel.edge_radius_mm``.
+        """
+        rf = {s: self.settings(s).edge_radius_mm for s in ("drive", "coast")}
+        rho_f = max(rf.values())
+        for side in ("drive", "coast"):
+            h0 = float(self.fillet_height(self.blank.mean_cone_distance, side))
+            if h0 >= 0.0:
+                raise DesignError(
+                    "spiral_bevel.edge_radius_mm", rf[side], "an edge radius below the pitch cone",
+                    f"{self.name} {side}: the fillet limit is {h0:.3f} mm above the mean point",
+                )  # fmt: skip
+        L, land = self.root_land()
+        k = int(np.argmin(land))
+        if land[k] <= 0.0:
+            # about: the land shrinks by Σ ρ_f (1 − sin α)/cos α (normal section) / cos β
+            al = [math.radians(self.settings(s).blade_angle_deg) for s in rf]
+            take = sum((1 - math.sin(a)) / math.cos(a) for a in al)
+            cb = math.cos(math.radians(self.blank.spiral_angle_deg))
+            est = rho_f + land[k] * cb / take
+            raise DesignError(
+                "spiral_bevel.edge_radius_mm", rho_f, "an edge radius whose fillets fit in a "
+                "tooth space (what the blade points can carry)",
+                f"{self.name}: the fillets of a tooth space overlap by {-land[k]:.3f} mm at "
+                f"L = {L[k]:.2f} mm; about {max(est, 0.0):.2f} mm fits",
+            )  # fmt: skip
 
     # ------------------------------------------------------------------ evaluation
     def _tools(self, side: Side):
@@ -192,11 +414,36 @@ class SpiralBevelMember:
             nf = self._cache[key] = NativeFlank.build(self, side)
         return nf
 
+    def native_fillet(self, side: Side) -> NativeFillet:
+        """Fast exact evaluator of the ``side`` fillet in the edge-radius parameters ``(ϑ, θ)``
+        (built once, cached; :class:`NativeFillet`)."""
+        key = ("native_fillet", side)
+        nf = self._cache.get(key)
+        if nf is None:
+            self.settings(side)  # validates the side
+            nf = self._cache[key] = NativeFillet.build(self, side)
+        return nf
+
+    def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
+        """Exact points and normals at flank coordinates ``(u, v)`` through the fast native
+        evaluators (:meth:`native_flank` for ``u >= 0``, :meth:`native_fillet` below): the same
+        surfaces as :meth:`point_normal` to ~1e-12 mm, ~100× faster."""
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        f = u < 0
+        p, n = np.empty(u.shape + (3,)), np.empty(u.shape + (3,))
+        for mask, nf in ((~f, self.native_flank), (f, self.native_fillet)):
+            if mask.any():
+                e = nf(side)
+                p[mask], n[mask] = e.evaluate(*e.native(u[mask], v[mask]))
+        return p, n
+
     def _solve(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Envelope, Array, Array]:
+        """Blade envelope at working flank coordinates ``(u >= 0, v)``: 2-D Newton on the
+        cutter parameters ``(s, θ)`` for the target ``(L, h)``."""
         tool, mot = self._tools(side)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         L_t = v
-        h_t = self.height(u, v)
+        h_t = self.height(u, v, side)
         g = self.pitch_angle
         # linear predictor from the mean point (s = θ = ψ = 0 by construction)
         e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
@@ -232,24 +479,42 @@ class SpiralBevelMember:
         return env, s, th
 
     def evaluate(self, side: Side, u: ArrayLike, v: ArrayLike) -> FlankEvaluation:
-        """Points, normals, principal curvatures, tool parameters and residuals at ``(u, v)``."""
-        env, s, th = self._solve(side, u, v)
-        k, dirs = env.curvatures()
-        return FlankEvaluation(
-            points=env.points,
-            normals=env.normals,
-            kappa=k,
-            directions=dirs,
-            tool_s=s,
-            tool_theta=th,
-            psi=env.psi,
-            meshing_residual=env.residual,
-        )
+        """Points, normals, principal curvatures, tool parameters and residuals at ``(u, v)``
+        (the blade envelope for ``u >= 0``, the edge-radius envelope, the fillet, below)."""
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        f = u < 0
+        parts = []
+        if (~f).any():
+            parts.append((~f, *self._solve(side, u[~f], v[~f])))
+        if f.any():
+            parts.append((f, *self._fillet_solve(side, u[f], v[f])))
+        shapes = {"points": (3,), "normals": (3,), "kappa": (2,), "directions": (2, 3),
+                  "tool_s": (), "tool_theta": (), "psi": (), "meshing_residual": ()}  # fmt: skip
+        out = {k: np.empty(u.shape + sh) for k, sh in shapes.items()}
+        for mask, env, a, th in parts:
+            k, dirs = env.curvatures()
+            vals = {"points": env.points, "normals": env.normals, "kappa": k, "directions": dirs,
+                    "tool_s": a, "tool_theta": th, "psi": env.psi,
+                    "meshing_residual": env.residual}  # fmt: skip
+            for name, val in vals.items():
+                out[name][mask] = val
+        return FlankEvaluation(**out)
 
     def point_normal(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
-        """Exact points ``(..., 3)`` mm and outward unit normals at ``(u, v)``."""
-        env, _, _ = self._solve(side, u, v)
-        return env.points, env.normals
+        """Exact points ``(..., 3)`` mm and outward unit normals at ``(u, v)`` (the engine):
+        the blade envelope for ``u >= 0``, the generated fillet for ``u < 0``."""
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        f = u < 0
+        if not f.any():
+            env, _, _ = self._solve(side, u, v)
+            return env.points, env.normals
+        p, n = np.empty(u.shape + (3,)), np.empty(u.shape + (3,))
+        if (~f).any():
+            env = self._solve(side, u[~f], v[~f])[0]
+            p[~f], n[~f] = env.points, env.normals
+        env = self._fillet_solve(side, u[f], v[f])[0]
+        p[f], n[f] = env.points, env.normals
+        return p, n
 
     def flank(self, side: Side, nu: int = 21, nv: int = 11) -> FlankSurface:
         """Tooth-0 flank on an ``nu × nv`` grid: u fillet limit → face cone, v toe → heel."""
@@ -297,16 +562,27 @@ class SpiralBevelPair:
         targets: SynthesisTargets | None = None,
         settings: SpiralBevelSettings | None = None,
     ) -> SpiralBevelPair:
-        """Synthesize the machine settings (unless given) and build both members."""
+        """Synthesize the machine settings (unless given) and build both members; choose the
+        blade edge radius if the blank leaves it open (:func:`_default_edge_radius`); refuse an
+        edge radius whose fillets do not fit (:meth:`SpiralBevelMember.check_fillets`)."""
         blank = blank or SpiralBevelBlank()
         targets = targets or SynthesisTargets()
         synth, reports = synthesize(blank, targets)
+        synth_final = None
         if settings is None:
             settings = synth
             if targets.symmetric_te:
                 for side in ("drive", "coast"):
                     settings = _tune_third_order_roll(blank, targets, settings, reports, side)
-        return cls._build(blank, targets, settings, reports)
+            synth_final = settings
+        pair = cls._build(blank, targets, settings, reports)
+        if blank.edge_radius_mm is None and settings is synth_final:
+            rho = _default_edge_radius(pair)
+            if rho != blank.edge_radius:
+                pair = cls._build(blank, targets, _with_edge_radius(settings, rho), reports)
+        for m in (pair.pinion, pair.gear):
+            m.check_fillets()  # the edge radius fits (DesignError naming it otherwise)
+        return pair
 
     @classmethod
     def _build(cls, blank, targets, settings, reports) -> SpiralBevelPair:
@@ -330,6 +606,46 @@ class SpiralBevelPair:
             self.blank, side, r.gear_flank_angle, r.pinion_flank_angle, r.sigma
         )
         return pin, gear
+
+
+def _with_edge_radius(settings: SpiralBevelSettings, rho: float) -> SpiralBevelSettings:
+    """``settings`` with every blade's edge radius set to ``rho`` (mm)."""
+    return SpiralBevelSettings(
+        **{
+            k: replace(settings.get(*k.split("_")), edge_radius_mm=float(rho))
+            for k in ("gear_drive", "gear_coast", "pinion_drive", "pinion_coast")
+        }
+    )
+
+
+def _default_edge_radius(pair: SpiralBevelPair, keep: float = 0.2) -> float:
+    """The default blade edge radius (mm): ``0.25 m``, or ``(1 − keep)`` of the largest radius
+    the tooth spaces carry where that is smaller.
+
+    The root land of a tooth space (:meth:`SpiralBevelMember.root_land`) falls linearly with
+    the edge radius, ``land(ρ) = W − K ρ`` (each edge radius takes ``ρ (1 − sin α)/cos α`` of the
+    root in the normal section; measured linear to 1e-4 mm over 0.4 … 1.24 mm), with ``W`` the
+    point width the sharp blades would leave. From the lands at the trial ``ρ_0 = 0.25 m`` (the
+    pair as synthesized) and at ``ρ_0/2``: ``K``, ``W`` and the largest radius
+    ``ρ_max = min W/K`` over both members and the face; the default keeps ``keep`` of the point
+    width as root land: ``ρ = min(ρ_0, (1 − keep) ρ_max)``.
+    """
+    r0 = pair.blank.edge_radius
+    st = _with_edge_radius(pair.settings, 0.5 * r0)
+    half = SpiralBevelPair._build(pair.blank, pair.targets, st, pair.reports)
+    rho_max, where = math.inf, ""
+    for m0, m1 in ((pair.pinion, half.pinion), (pair.gear, half.gear)):
+        L, l0 = m0.root_land()
+        l1 = m1.root_land()[1]
+        K = (l1 - l0) / (0.5 * r0)
+        W = l0 + K * r0
+        k = int(np.argmin(W / K))
+        if W[k] / K[k] < rho_max:
+            rho_max, where = float(W[k] / K[k]), f"{m0.name} at L = {L[k]:.2f} mm, W {W[k]:.3f} mm"
+    rho = min(r0, (1.0 - keep) * rho_max)
+    log.info("spiral bevel: blade edge radius %.4f mm (the tooth spaces carry %.4f mm: %s)",
+             rho, rho_max, where)  # fmt: skip
+    return rho
 
 
 def _contact(pair: SpiralBevelPair, side: Side, phi1: float, x: Array) -> tuple[Array, float]:
@@ -385,8 +701,8 @@ def transmission_error(
         Max abs residual of the contact equations (mm / unit normals).
     """
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
-    u1, v1 = pair.pinion.mean_parameters()
-    u2, v2 = pair.gear.mean_parameters()
+    u1, v1 = pair.pinion.mean_parameters(side)
+    u2, v2 = pair.gear.mean_parameters(side)
     x0 = np.array([u1, v1, u2, v2, 0.0])
     X = np.empty((phi1.size, 5))
     res = np.empty(phi1.size)
@@ -530,14 +846,16 @@ def _apply_step(st: _Step, psi: Array, x: list[Array], w: float) -> list[Array]:
 
 
 @dataclass(frozen=True)
-class NativeFlank:
-    """Exact, fast evaluation of one generated bevel flank in its cutter parameters ``(s, θ)``.
+class _NativeEnvelope:
+    """Exact, fast evaluation of the envelope of one cutter surface of revolution in its native
+    parameters ``(a, θ)`` (profile parameter, cutter angle): the shared part of
+    :class:`NativeFlank` (blade) and :class:`NativeFillet` (edge radius).
 
-    The generated surface is ``r(s, θ) = M(ψ(s, θ)) r_t(s, θ)`` with ``ψ`` the root of the
+    The generated surface is ``r(a, θ) = M(ψ(a, θ)) r_t(a, θ)`` with ``ψ`` the root of the
     equation of meshing ``f = (M n_t) · (M' r_t) = 0`` (Litvin & Fuentes 2004 §6.1). Instead of
     the bracketing solve of :func:`~fegear.geometry.generation.generate` at every call, ``ψ`` is
-    predicted by a bicubic spline tabulated once (by the engine) over the working flank and a
-    margin of 0.75 of its span around it, then corrected by Newton on the meshing equation,
+    predicted by a bicubic spline tabulated once (by the engine) over the surface and a margin
+    around it, then corrected by Newton on the meshing equation,
 
     .. math::  \\psi \\leftarrow \\psi - f / f_\\psi, \\qquad
                f_\\psi = (M' n_t)\\cdot(M' r_t) + (M n_t)\\cdot(M'' r_t),
@@ -547,17 +865,11 @@ class NativeFlank:
     products), with the ψ-derivatives propagated by the product rule. The result is the exact
     envelope (the engine's root, to round-off: ~1e-13 mm, tested), NOT an interpolant; the
     spline only supplies the Newton start. Tangents follow from the implicit-function theorem:
-    ``ψ_s = −f_s/f_ψ``, ``r_s = M r_{t,s} + (M' r_t) ψ_s`` (same for θ).
+    ``ψ_a = −f_a/f_ψ``, ``r_a = M r_{t,a} + (M' r_t) ψ_a`` (same for θ).
 
-    Tool (head cutter, :class:`~.spiral_bevel_settings.HeadCutter`): a surface of revolution
-    with blade profile ``(ρ(s), z(s))``, so ``r_t = (ρ cos θ, ρ sin θ, z)`` and
-    ``n_t = ± (−z' cos θ, −z' sin θ, ρ') / √(ρ'² + z'²)`` in closed form.
-
-    Flank coordinates (:class:`SpiralBevelMember`): ``v = L`` (cone distance), ``u`` the fraction
-    of the working height ``(h − h_f(L))/(h_a(L) − h_f(L))``; ``(u, v) → (s, θ)`` by 2-D Newton
-    on ``(L, h)`` with the analytic tangents from a bicubic predictor.
-
-    Build with :meth:`SpiralBevelMember.native_flank`.
+    Tool: a surface of revolution with profile ``(ρ(a), z(a))`` (``tool.profile``), so
+    ``r_t = (ρ cos θ, ρ sin θ, z)`` and ``n_t = σ (−z' cos θ, −z' sin θ, ρ') / √(ρ'² + z'²)`` in
+    closed form (``σ = tool.sign``).
     """
 
     member: SpiralBevelMember
@@ -568,22 +880,16 @@ class NativeFlank:
     inverse: tuple[object, object]
     box: tuple[Array, Array]
 
-    # ---------------------------------------------------------------- construction
-    @classmethod
-    def build(cls, member: SpiralBevelMember, side: Side, n_grid: int = 41) -> NativeFlank:
-        """Tabulate ψ on an ``n_grid²`` grid of ``(s, θ)`` covering the flank ± 0.75 its span."""
+    @staticmethod
+    def _psi_table(member: SpiralBevelMember, side: Side, tool, lo: Array, hi: Array,
+                   margin: tuple[float, float], n_grid: int):  # fmt: skip
+        """Bicubic spline of the meshing root ψ over ``(a, θ)`` in ``[lo, hi]`` widened by
+        ``margin`` times its span on each side (``n_grid²`` engine roots)."""
         from scipy.interpolate import RectBivariateSpline
 
-        tool, mot = member._tools(side)
-        b = member.boundaries()
-        uu = np.linspace(b.u_fillet, b.u_tip, 9)
-        vv = np.linspace(b.v_start, b.v_end, 9)
-        _, s0, t0 = member._solve(side, uu[:, None], vv[None, :])
-        inv = (RectBivariateSpline(uu, vv, s0), RectBivariateSpline(uu, vv, t0))
-        lo = np.array([s0.min(), t0.min()])
-        hi = np.array([s0.max(), t0.max()])
+        mot = member._tools(side)[1]
         span = hi - lo
-        glo, ghi = lo - 0.75 * span, hi + 0.75 * span
+        glo, ghi = lo - np.multiply(margin, span), hi + np.multiply(margin, span)
         gs = np.linspace(glo[0], ghi[0], n_grid)
         gt = np.linspace(glo[1], ghi[1], n_grid)
         S, T = np.meshgrid(gs, gt, indexing="ij")
@@ -612,22 +918,17 @@ class NativeFlank:
             D = np.stack([x**i * y**j for i in range(4) for j in range(4 - i)], -1)
             c = np.linalg.lstsq(D[ok], psi[ok], rcond=None)[0]
             psi = np.where(ok, psi, D @ c)
-        spl = RectBivariateSpline(gs, gt, psi, kx=3, ky=3)
-        return cls(member, side, tool, _compile(mot.factors), spl, inv, (lo, hi))
+        return RectBivariateSpline(gs, gt, psi, kx=3, ky=3)
 
     # ---------------------------------------------------------------- evaluation
     def _tool(self, s: Array, th: Array, derivs: bool) -> tuple[Array, ...]:
-        """Head-cutter point, normal (into the tool) and, with ``derivs``, their s/θ-derivatives.
+        """Tool point, normal (into the tool) and, with ``derivs``, their a/θ-derivatives.
 
-        Same surface as :meth:`HeadCutter.evaluate`, closed form for a surface of revolution.
+        Same surface as ``tool.evaluate``, closed form for a surface of revolution.
         """
         t = self.tool
-        sa, ca = math.sin(t.blade_angle), math.cos(t.blade_angle)
-        sg = 1.0 if t.outside else -1.0
-        d_r, d_z, n_r, n_z, a = sg * sa, ca, -sg * ca, sa, t.parabola
-        rho = t.radius + s * d_r - a * s**2 * n_r
-        z = s * d_z - a * s**2 * n_z
-        rho1, z1 = d_r - 2 * a * s * n_r, d_z - 2 * a * s * n_z
+        sg = t.sign
+        rho, z, rho1, z1, rho2, z2 = t.profile(s)
         wn = np.hypot(rho1, z1)
         # n = sg (r_s × r_θ)/|·| = sg (−z' cos θ, −z' sin θ, ρ')/|(ρ', z')|   (ρ > 0)
         Nr, Nz = -sg * z1 / wn, sg * rho1 / wn
@@ -636,7 +937,6 @@ class NativeFlank:
         n = np.stack([Nr * c, Nr * si, Nz], -1)
         if not derivs:
             return r, n
-        rho2, z2 = -2 * a * n_r, -2 * a * n_z
         # d/ds of the unit profile normal: (q' − N (N·q'))/|q|, q = sg (−z', ρ')
         qr, qz = -sg * z2, sg * rho2
         dot = Nr * qr + Nz * qz
@@ -671,7 +971,7 @@ class NativeFlank:
         return psi, r, n, fp
 
     def evaluate(self, s: ArrayLike, th: ArrayLike, tangents: bool = False) -> tuple[Array, ...]:
-        """Points ``(..., 3)`` and unit normals; with ``tangents`` also ``r_s``, ``r_θ``."""
+        """Points ``(..., 3)`` and unit normals; with ``tangents`` also ``r_a``, ``r_θ``."""
         s, th = np.broadcast_arrays(np.asarray(s, dtype=float), np.asarray(th, dtype=float))
         shape = s.shape
         s, th = s.ravel(), th.ravel()
@@ -687,25 +987,57 @@ class NativeFlank:
         return tuple(o.reshape(shape + (3,)) for o in out)
 
     def psi(self, s: ArrayLike, th: ArrayLike) -> Array:
-        """Root ψ (rad) of the equation of meshing at ``(s, θ)``."""
+        """Root ψ (rad) of the equation of meshing at ``(a, θ)``."""
         s, th = np.broadcast_arrays(np.asarray(s, dtype=float), np.asarray(th, dtype=float))
         tl = self._tool(s.ravel(), th.ravel(), False)
         return self._solve_psi(s.ravel(), th.ravel(), *tl)[0].reshape(s.shape)
 
     def meshing_residual(self, s: ArrayLike, th: ArrayLike) -> Array:
-        """``|n·v|/|v|`` of the equation of meshing at ``(s, θ)`` (a check of the solve)."""
+        """``|n·v|/|v|`` of the equation of meshing at ``(a, θ)`` (a check of the solve)."""
         s, th = np.broadcast_arrays(np.asarray(s, dtype=float), np.asarray(th, dtype=float))
         tl = self._tool(s.ravel(), th.ravel(), False)
         _, r, n, _ = self._solve_psi(s.ravel(), th.ravel(), *tl)
         res = np.abs(np.sum(n[0] * r[1], -1)) / np.linalg.norm(r[1], axis=-1)
         return res.reshape(s.shape)
 
+
+@dataclass(frozen=True)
+class NativeFlank(_NativeEnvelope):
+    """Exact, fast evaluation of one generated bevel flank (the blade envelope) in its cutter
+    parameters ``(s, θ)`` (:class:`_NativeEnvelope`; tool:
+    :class:`~.spiral_bevel_settings.HeadCutter`).
+
+    The ψ table covers the working flank and a margin of 0.75 of its span around it (41 × 41
+    engine roots, ~0.1 s). Flank coordinates (:class:`SpiralBevelMember`): ``v = L`` (cone
+    distance), ``u`` the fraction of the working height ``(h − h_fl(L))/(h_a(L) − h_fl(L))``
+    above the fillet limit; ``(u, v) → (s, θ)`` by 2-D Newton on ``(L, h)`` with the analytic
+    tangents from a bicubic predictor.
+
+    Build with :meth:`SpiralBevelMember.native_flank`.
+    """
+
+    @classmethod
+    def build(cls, member: SpiralBevelMember, side: Side, n_grid: int = 41) -> NativeFlank:
+        """Tabulate ψ on an ``n_grid²`` grid of ``(s, θ)`` covering the flank ± 0.75 its span."""
+        from scipy.interpolate import RectBivariateSpline
+
+        tool, mot = member._tools(side)
+        b = member.boundaries()
+        uu = np.linspace(b.u_fillet, b.u_tip, 9)
+        vv = np.linspace(b.v_start, b.v_end, 9)
+        _, s0, t0 = member._solve(side, uu[:, None], vv[None, :])
+        inv = (RectBivariateSpline(uu, vv, s0), RectBivariateSpline(uu, vv, t0))
+        lo = np.array([s0.min(), t0.min()])
+        hi = np.array([s0.max(), t0.max()])
+        spl = cls._psi_table(member, side, tool, lo, hi, (0.75, 0.75), n_grid)
+        return cls(member, side, tool, _compile(mot.factors), spl, inv, (lo, hi))
+
     # ---------------------------------------------------------------- flank coordinates
     def flank(self, p: Array) -> tuple[Array, Array]:
-        """Flank coordinates ``(u, v)`` of member-frame points ``p (..., 3)``."""
+        """Flank coordinates ``(u, v)`` of member-frame points ``p (..., 3)`` of the working
+        surface (``u < 0`` for points below the fillet limit; not the fillet's own ``u``)."""
         L, h, _, _ = _cone_coords(p, self.member.pitch_angle)
-        h_f, h_a = self.member.blank.flank_heights(self.member.index, L)
-        return (h - h_f) / (h_a - h_f), L
+        return self.member.working_u(h, L, self.side), L
 
     def native(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11) -> tuple[Array, Array]:
         """``(s, θ)`` of flank coordinates (2-D Newton on ``(L, h)``, analytic tangents)."""
@@ -716,7 +1048,8 @@ class NativeFlank:
         last evaluation, at the converged ``(s, θ)``."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         m = self.member
-        L_t, h_t = v, m.height(u, v)
+        h_fl = m.fillet_height(v, self.side)
+        L_t, h_t = v, h_fl + u * (m.blank.flank_heights(m.index, v)[1] - h_fl)
         s = self.inverse[0].ev(u, v)
         th = self.inverse[1].ev(u, v)
         g = m.pitch_angle
@@ -741,3 +1074,64 @@ class NativeFlank:
         if not np.isfinite(err):
             raise SolverError(f"spiral bevel {m.name} {self.side}: (u, v) -> (s, theta) NaN")
         return s, th, p, n
+
+
+@dataclass(frozen=True)
+class NativeFillet(_NativeEnvelope):
+    """Exact, fast evaluation of one generated fillet (the envelope of the blade's edge radius,
+    :class:`~.spiral_bevel_settings.EdgeRadius`) in its native parameters ``(ϑ, θ)``
+    (:class:`_NativeEnvelope`).
+
+    Fillet coordinates ``u ∈ [−1, 0]`` (−1 on the root cone, 0 on the fillet limit), ``v = L``:
+    ``ϑ = (1 + u) ϑ_b`` and θ by Newton on the cone distance, ``∂L/∂θ = ∇L · r_θ`` (analytic
+    IFT tangent), from a bicubic predictor. The ψ table covers the fillet with margins of 0.25
+    (in ϑ: the arc is continued past its ends only a little) and 0.75 (in θ) of its spans.
+
+    Build with :meth:`SpiralBevelMember.native_fillet`.
+    """
+
+    @classmethod
+    def build(cls, member: SpiralBevelMember, side: Side, n_grid: int = 33) -> NativeFillet:
+        """Tabulate ψ on an ``n_grid²`` grid of ``(ϑ, θ)`` (exact fillet on 9 × 9 ``(u, v)``)."""
+        from scipy.interpolate import RectBivariateSpline
+
+        tool = member.edge_tool(side)
+        b = member.boundaries()
+        uu = np.linspace(b.u_root, b.u_fillet, 9)
+        vv = np.linspace(b.v_start, b.v_end, 9)
+        _, w0, t0 = member._fillet_solve(side, uu[:, None], vv[None, :])
+        inv = (RectBivariateSpline(uu, vv, w0), RectBivariateSpline(uu, vv, t0))
+        lo = np.array([w0.min(), t0.min()])
+        hi = np.array([w0.max(), t0.max()])
+        spl = cls._psi_table(member, side, tool, lo, hi, (0.25, 0.75), n_grid)
+        steps = _compile(member._tools(side)[1].factors)
+        return cls(member, side, tool, steps, spl, inv, (lo, hi))
+
+    def native(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11) -> tuple[Array, Array]:
+        """``(ϑ, θ)`` of fillet coordinates ``(u ∈ [−1, 0], v = L)``."""
+        return self.native_evaluation(u, v, tol)[:2]
+
+    def native_evaluation(self, u: ArrayLike, v: ArrayLike, tol: float = 1e-11):
+        """``(ϑ, θ, p, n)``: :meth:`native` and the evaluation at the converged parameters."""
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        m = self.member
+        w = (1.0 + u) * self.tool.theta_blade
+        th = self.inverse[1].ev(u, v)
+        g = m.pitch_angle
+        err = np.inf
+        for _ in range(30):
+            p, n, _, rt = self.evaluate(w, th, tangents=True)
+            L, _, gL, _ = _cone_coords(p, g)
+            F = L - v
+            err = float(np.max(np.abs(F))) if F.size else 0.0
+            if not err >= tol:
+                break
+            th = th - F / np.sum(gL * rt, -1)
+        else:
+            raise SolverError(
+                f"spiral bevel {m.name} {self.side}: fillet (u, v) -> (ϑ, θ) did not converge "
+                f"(max |dL| = {err:.2e} mm)"
+            )
+        if not np.isfinite(err):
+            raise SolverError(f"spiral bevel {m.name} {self.side}: fillet (u, v) -> (ϑ, θ) NaN")
+        return w, th, p, n

@@ -23,9 +23,12 @@ Flank coordinates of a point ``p`` of member ``i`` (axial plane, pitch angle γ)
     h = ρ cos γ − z sin γ      height above the pitch cone (normal to the generatrix)
 
 The flank runs from the toe ``L = A0 − F`` to the heel ``L = A0`` (back/front cones normal to the
-pitch cone) and from the fillet limit ``h_f(L) = −a_j + (A0 − L) tan δ_fi`` (the mate's face cone:
-the working depth; the fillet itself is not modelled) to the face cone
-``h_a(L) = a_i − (A0 − L) tan δ_fj``.
+pitch cone) and from the root cone ``h_R(L) = −b_i + (A0 − L) tan δ_fi`` (through the apex) up the
+generated fillet to the fillet limit (where the blade meets its edge radius, a curve over the face:
+:meth:`~fegear.geometry.spiral_bevel.SpiralBevelMember.fillet_height`) and on to the face cone
+``h_a(L) = a_i − (A0 − L) tan δ_fj``. The mate's face cone reaches down to the working depth
+``h_w(L) = −a_j + (A0 − L) tan δ_fi`` (the clearance ``c`` above the root cone): the lowest point
+that can be in contact in the nominal mesh (:meth:`SpiralBevelBlank.flank_heights`).
 
 Generating machine (one per flank: "fixed setting" for every flank, see :class:`MachineSettings`)
 -------------------------------------------------------------------------------------------------
@@ -99,6 +102,9 @@ __all__ = [
     "SpiralBevelSettings",
     "SynthesisReport",
     "HeadCutter",
+    "EdgeRadius",
+    "blade_tip",
+    "point_plane",
     "machine_motion",
     "synthesize",
     "mean_point",
@@ -109,6 +115,8 @@ log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 Side = Literal["drive", "coast"]
 ARCSEC = math.pi / (180.0 * 3600.0)
+#: default blade edge radius in modules: the ISO 53 basic rack profile C tip radius 0.25 m
+EDGE_RADIUS_MODULES = 0.25
 
 
 # --------------------------------------------------------------------------------------------
@@ -138,6 +146,19 @@ class SpiralBevelBlank:
         Nominal gear head-cutter radius (mean radius of the blade at the mean point). Default
         76.2 mm: the standard 6-inch-diameter Gleason cutter for this size (Gleason's tables
         recommend a cutter radius close to the mean cone distance for spiral angles ~35°).
+    edge_radius_mm
+        Edge (tip) radius ``ρ_f`` of every blade, mm (> 0): the blade profile ends in an arc
+        tangent to the blade and to the cutter's point plane (:class:`EdgeRadius`); it generates
+        the fillet. The arc rises ``ρ_f (1 − sin α)`` above the point plane along the cutter
+        axis. None (default): chosen by
+        :meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.design` as ``0.25 m`` (the tip
+        radius of the ISO 53 basic rack profile C, ``ρ_fP = 0.25 m``) where the tooth spaces of
+        both members carry it with at least 20 % of their point width left as root land, else
+        80 % of the largest radius they carry. The reference pair's gear tooth spaces are
+        narrowest at the heel (point width 1.74 mm) and carry at most 1.01 mm, so 0.25 m =
+        1.235 mm does not fit: 0.81 mm (0.164 m) it is. A radius whose fillets do not fit in a
+        tooth space (more than the blade points can carry) is refused
+        (:meth:`~fegear.geometry.spiral_bevel.SpiralBevelMember.check_fillets`).
     """
 
     n1: int = 12
@@ -148,6 +169,7 @@ class SpiralBevelBlank:
     face_width_mm: float = 25.4
     shaft_angle_deg: float = 90.0
     cutter_radius_mm: float = 76.2
+    edge_radius_mm: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("n1", "n2"):
@@ -162,6 +184,10 @@ class SpiralBevelBlank:
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
                 raise InputError(f"spiral_bevel.{name}", v, "> 0")
+        if self.edge_radius_mm is not None and not (
+            np.isfinite(self.edge_radius_mm) and self.edge_radius_mm > 0
+        ):
+            raise InputError("spiral_bevel.edge_radius_mm", self.edge_radius_mm, "> 0 (or unset)")
         if not 0.0 < self.shaft_angle_deg < 180.0:
             raise InputError("spiral_bevel.shaft_angle_deg", self.shaft_angle_deg, "in (0, 180)")
         if not 0.0 <= self.spiral_angle_deg <= 50.0:
@@ -193,6 +219,15 @@ class SpiralBevelBlank:
     @property
     def beta_deg(self) -> float:
         return self.spiral_angle_deg
+
+    @property
+    def edge_radius(self) -> float:
+        """Blade edge radius ``ρ_f`` (mm) the synthesis puts on the cutters: ``edge_radius_mm``,
+        or the ``0.25 m`` that :meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.design`
+        then reduces if the tooth spaces do not carry it (see ``edge_radius_mm``)."""
+        if self.edge_radius_mm is None:
+            return EDGE_RADIUS_MODULES * self.module_mm
+        return float(self.edge_radius_mm)
 
     @property
     def m21(self) -> float:
@@ -251,13 +286,21 @@ class SpiralBevelBlank:
         t2 = 0.5 * p - (a1 - a2) * math.tan(al) / math.cos(be)
         return p - t2, t2
 
+    def root_height(self, i: int, L: Array | float) -> Array:
+        """Height ``h_R(L) = −b_i + (A0 − L) tan δ_fi`` of the root cone of member i (mm)."""
+        A0 = self.outer_cone_distance
+        L = np.asarray(L, dtype=float)
+        return -self.dedenda[i - 1] + (A0 - L) * math.tan(self.dedendum_angles[i - 1])
+
     def half_tooth_angle(self, i: int) -> float:
         """Half the transverse tooth-thickness angle of member i (1|2) at the mean point, rad."""
         t = self.thickness_heel[i - 1] * self.mean_cone_distance / self.outer_cone_distance
         return 0.5 * t / (self.mean_cone_distance * math.sin(self.pitch_angles[i - 1]))
 
     def flank_heights(self, i: int, L: Array | float) -> tuple[Array, Array]:
-        """Fillet limit ``h_f(L)`` and face-cone ``h_a(L)`` heights of member i (mm)."""
+        """Working depth ``h_w(L)`` (the mate's face cone, nominal mesh: the clearance above the
+        root cone) and face-cone height ``h_a(L)`` of member i (mm). The flank itself reaches
+        down to the fillet limit, below ``h_w`` (:mod:`fegear.geometry.spiral_bevel`)."""
         A0 = self.outer_cone_distance
         a = self.addenda
         d = self.dedendum_angles
@@ -354,6 +397,10 @@ class MachineSettings:
         Blade radius in the cradle plane z_m = 0 (≈ at the root; derived, for reports).
     parabola_per_mm
         Parabolic blade coefficient a_c (0: straight blade).
+    edge_radius_mm
+        Blade edge radius ρ_f (> 0): the arc tangent to the blade and to the point plane that
+        generates the fillet (:class:`EdgeRadius`; the point plane is where the cutter cuts the
+        blank's root cone, :func:`point_plane`).
     radial_setting_mm, cradle_angle_deg
         Cutter centre on the cradle, polar (S_r, q) in the machine frame at ψ = 0.
     ref_height_mm
@@ -383,6 +430,7 @@ class MachineSettings:
     blade_angle_deg: float
     point_radius_mm: float
     parabola_per_mm: float
+    edge_radius_mm: float
     radial_setting_mm: float
     cradle_angle_deg: float
     ref_height_mm: float
@@ -405,6 +453,8 @@ class MachineSettings:
             raise InputError("machine_settings.blade_angle_deg", self.blade_angle_deg, "in (0, 60)")
         if not self.ratio_of_roll > 0:
             raise InputError("machine_settings.ratio_of_roll", self.ratio_of_roll, "> 0")
+        if not (np.isfinite(self.edge_radius_mm) and self.edge_radius_mm > 0):
+            raise InputError("machine_settings.edge_radius_mm", self.edge_radius_mm, "> 0")
 
 
 @dataclass(frozen=True)
@@ -420,6 +470,21 @@ class SpiralBevelSettings:
         return getattr(self, f"{member}_{side}")
 
 
+def _revolution_sample(prof: tuple[Array, ...], theta: Array, sg: float) -> ToolSample:
+    """Tool sample of the surface of revolution ``(ρ(w) cos θ, ρ(w) sin θ, z(w))`` from its
+    profile ``prof = (ρ, z, ρ', z', ρ'', z'')`` (w-derivatives); normal ``sg (r_w × r_θ)/|·|``."""
+    rho, z, rho1, z1, rho2, z2 = prof
+    c, si = np.cos(theta), np.sin(theta)
+    zero = np.zeros_like(rho)
+    r = np.stack([rho * c, rho * si, z], -1)
+    r_s = np.stack([rho1 * c, rho1 * si, z1], -1)
+    r_t = np.stack([-rho * si, rho * c, zero], -1)
+    r_ss = np.stack([rho2 * c, rho2 * si, z2], -1)
+    r_st = np.stack([-rho1 * si, rho1 * c, zero], -1)
+    r_tt = np.stack([-rho * c, -rho * si, zero], -1)
+    return tool_sample(r, r_s, r_t, r_ss, r_st, r_tt, sg)
+
+
 @dataclass(frozen=True)
 class HeadCutter:
     """Blade surface of revolution of a head cutter, tool frame (axis z_t, origin at z_ref).
@@ -429,6 +494,8 @@ class HeadCutter:
     ``n = (∓cos α, sin α)`` pointing into the blade (out of the cut tooth); s (mm) runs from the
     mean-point height towards the cutter head (towards the tooth tip). Surface
     ``r_t(s, θ) = (ρ cos θ, ρ sin θ, z)`` (Litvin & Fuentes 2004 §21.2; parabolic blade §21.5).
+    The blade ends at its edge radius (:class:`EdgeRadius`, :func:`blade_tip`); this surface is
+    the blade only, continued past that end (the envelope engine needs no limits).
     """
 
     radius: float
@@ -436,10 +503,16 @@ class HeadCutter:
     outside: bool
     parabola: float = 0.0
 
-    def evaluate(self, u: Array, theta: Array) -> ToolSample:
-        s, th = np.broadcast_arrays(np.asarray(u, float), np.asarray(theta, float))
+    @property
+    def sign(self) -> float:
+        """+1 outside blade, −1 inside blade."""
+        return 1.0 if self.outside else -1.0
+
+    def profile(self, s: Array) -> tuple[Array, ...]:
+        """``(ρ, z, ρ', z', ρ'', z'')`` of the blade profile at ``s`` (mm; derivatives in s)."""
+        s = np.asarray(s, float)
         sa, ca = math.sin(self.blade_angle), math.cos(self.blade_angle)
-        sg = 1.0 if self.outside else -1.0
+        sg = self.sign
         d_r, d_z = sg * sa, ca
         n_r, n_z = -sg * ca, sa
         a = self.parabola
@@ -449,15 +522,110 @@ class HeadCutter:
         z1 = d_z - 2 * a * s * n_z
         rho2 = np.full_like(s, -2 * a * n_r)
         z2 = np.full_like(s, -2 * a * n_z)
-        c, si = np.cos(th), np.sin(th)
-        zero = np.zeros_like(s)
-        r = np.stack([rho * c, rho * si, z], -1)
-        r_s = np.stack([rho1 * c, rho1 * si, z1], -1)
-        r_t = np.stack([-rho * si, rho * c, zero], -1)
-        r_ss = np.stack([rho2 * c, rho2 * si, z2], -1)
-        r_st = np.stack([-rho1 * si, rho1 * c, zero], -1)
-        r_tt = np.stack([-rho * c, -rho * si, zero], -1)
-        return tool_sample(r, r_s, r_t, r_ss, r_st, r_tt, sg)
+        return rho, z, rho1, z1, rho2, z2
+
+    def evaluate(self, u: Array, theta: Array) -> ToolSample:
+        s, th = np.broadcast_arrays(np.asarray(u, float), np.asarray(theta, float))
+        return _revolution_sample(self.profile(s), th, self.sign)
+
+
+@dataclass(frozen=True)
+class EdgeRadius:
+    """The edge radius (tip radius) of a head-cutter blade: a torus, tool frame.
+
+    Profile in the axial half-plane: the arc of radius ``ρ_f`` about the centre ``(ρ_c, z_c)``,
+
+    .. math::  P(\\vartheta) = (\\rho_c + \\sigma \\rho_f \\sin\\vartheta,\\;
+               z_c - \\rho_f \\cos\\vartheta), \\qquad 0 \\le \\vartheta \\le \\vartheta_b,
+
+    ``σ = +1`` outside blade, ``−1`` inside; unit normal into the tool (out of the cut tooth)
+    ``N(ϑ) = (−σ sin ϑ, cos ϑ)``, pointing at the centre. At ``ϑ = 0`` the arc touches the
+    cutter's *point plane* ``z = z_c − ρ_f`` (normal along the cutter axis: it cuts the root
+    cone); at ``ϑ_b`` it touches the blade at ``s_b`` with the blade's normal (for a straight
+    blade ``ϑ_b = 90° − α``): the tool is G1 across both joins (Litvin & Fuentes 2004 §21.2,
+    "blade with a fillet"; Litvin & Zhang, NASA CR-4342, 1991, §2; Gleason's edge radius).
+    Surface ``r_t(ϑ, θ) = (ρ cos θ, ρ sin θ, z)``; the envelope of it under the blade's
+    generating motion is the fillet of the flank the blade cuts.
+    """
+
+    centre_radius: float
+    centre_z: float
+    edge_radius: float
+    outside: bool
+    theta_blade: float
+    s_blade: float
+
+    @property
+    def sign(self) -> float:
+        return 1.0 if self.outside else -1.0
+
+    @property
+    def point_z(self) -> float:
+        """``z_t`` of the point plane (the lowest point of the blade), mm."""
+        return self.centre_z - self.edge_radius
+
+    def profile(self, w: Array) -> tuple[Array, ...]:
+        """``(ρ, z, ρ', z', ρ'', z'')`` of the arc at ``ϑ = w`` (rad; derivatives in ϑ)."""
+        w = np.asarray(w, float)
+        sg, rf = self.sign, self.edge_radius
+        sw, cw = np.sin(w), np.cos(w)
+        return (
+            self.centre_radius + sg * rf * sw,
+            self.centre_z - rf * cw,
+            sg * rf * cw,
+            rf * sw,
+            -sg * rf * sw,
+            rf * cw,
+        )
+
+    def evaluate(self, u: Array, theta: Array) -> ToolSample:
+        w, th = np.broadcast_arrays(np.asarray(u, float), np.asarray(theta, float))
+        return _revolution_sample(self.profile(w), th, self.sign)
+
+
+def blade_tip(cutter: HeadCutter, edge_radius: float, point_z: float) -> EdgeRadius:
+    """The edge radius ``ρ_f`` of ``cutter``'s blade that touches the point plane ``z = point_z``.
+
+    The centre of the arc lies ``ρ_f`` inside the blade along its unit profile normal
+    ``N(s) = σ(−z', ρ')/|(ρ', z')|`` and ``ρ_f`` above the point plane:
+    ``z(s_b) + ρ_f N_z(s_b) = point_z + ρ_f``. For a straight blade
+    ``s_b = (point_z + ρ_f (1 − sin α)) / cos α``; for a parabolic blade Newton from there
+    (``d/ds (z + ρ_f N_z)`` by the curvature of the profile). ``ϑ_b`` from
+    ``N(ϑ_b) = N(s_b)``: ``sin ϑ_b = z'/|·|``, ``cos ϑ_b = σ ρ'/|·|``.
+
+    Raises :class:`~fegear.errors.DesignError` if the blade does not descend to the point plane
+    (a blade that turns over before it reaches it).
+    """
+    sa, ca = math.sin(cutter.blade_angle), math.cos(cutter.blade_angle)
+    sg, rf = cutter.sign, float(edge_radius)
+    s = (point_z + rf * (1.0 - sa)) / ca
+
+    def centre(s: float) -> tuple[float, float, float, float]:
+        rho, z, rho1, z1, _, _ = (float(x) for x in cutter.profile(np.array(s)))
+        wn = math.hypot(rho1, z1)
+        return rho + rf * (-sg * z1 / wn), z + rf * (sg * rho1 / wn), rho1 / wn, z1 / wn
+
+    for _ in range(50):
+        f = centre(s)[1] - (point_z + rf)
+        h = 1e-6
+        fp = (centre(s + h)[1] - centre(s - h)[1]) / (2 * h)
+        if not fp > 0:
+            raise DesignError(
+                "spiral_bevel.edge_radius_mm", rf, "an edge radius the blade can carry",
+                "the blade does not descend to the point plane",
+            )  # fmt: skip
+        ds = f / fp
+        s -= ds
+        if abs(ds) < 1e-14 * max(1.0, abs(s)):
+            break
+    rc, zc, t_r, t_z = centre(s)
+    theta_b = math.atan2(t_z, sg * t_r)
+    if not 0.0 < theta_b < math.pi:
+        raise DesignError(
+            "spiral_bevel.edge_radius_mm", rf, "an edge radius the blade can carry",
+            f"blade direction at its tip turns away from the point plane (ϑ_b {theta_b:.3f})",
+        )  # fmt: skip
+    return EdgeRadius(rc, zc, rf, cutter.outside, float(theta_b), float(s))
 
 
 def head_cutter(ms: MachineSettings) -> HeadCutter:
@@ -467,6 +635,32 @@ def head_cutter(ms: MachineSettings) -> HeadCutter:
         outside=ms.blade == "outside",
         parabola=ms.parabola_per_mm,
     )
+
+
+def point_plane(blank: SpiralBevelBlank, i: int, ms: MachineSettings) -> float:
+    """``z_t`` (tool frame, mm) of the cutter's point plane for member i: the plane
+    ``z_m = const`` of the machine that touches the blank's root cone at the mean cone distance.
+
+    The point plane is normal to the cutter (and cradle) axis; under the generating motion it
+    turns in itself with the cradle and sweeps, with the blank's rotation about its own axis, a
+    cone coaxial with the blank whose semi-angle is the machine root angle γ_m. Touching the
+    root circle at ``L = R_m`` (``h_R = −b_m``, the mean dedendum; its extreme ``z_m``,
+    ``c_z + ρ_R |(a_z, b_z)|`` with centre ``c`` and in-plane axes ``a``, ``b`` of the circle in
+    the machine frame at ψ = 0) this cone IS the root cone when ``γ_m = γ − δ_f`` (the
+    synthesized settings: the root cone touches the cradle plane ``z_m = 0`` along a
+    generatrix, so the plane is ``z_m = 0``), and it cuts the root cone depth at the mean point
+    otherwise. In the tool frame (origin at ``z_ref``): ``z_t = z_m − z_ref``. The depth of the
+    mean point above it along the cutter axis is ``R_m sin δ_f = b_m cos δ_f`` (tested).
+    """
+    g = blank.pitch_angles[i - 1]
+    L = blank.mean_cone_distance
+    h = float(blank.root_height(i, L))
+    rho = L * math.sin(g) + h * math.cos(g)
+    z = L * math.cos(g) - h * math.sin(g)
+    B = blank_placement(ms)
+    c = B[:3, :3] @ np.array([0.0, 0.0, z]) + B[:3, 3]
+    top = c[2] + rho * math.hypot(B[2, 0], B[2, 1])
+    return float(top - ms.ref_height_mm)
 
 
 def blank_placement(ms: MachineSettings) -> Array:
@@ -521,8 +715,11 @@ def fit_cutter(
     ratio_of_roll: float,
     modified_roll: float = 0.0,
     blank_offset: float = 0.0,
+    *,
+    edge_radius: float,
 ) -> MachineSettings:
-    """Settings whose cutter passes through ``point`` with outward tooth normal ``normal``.
+    """Settings whose cutter passes through ``point`` with outward tooth normal ``normal``
+    (blade edge radius ``edge_radius``, mm).
 
     A surface of revolution has its normals meeting its axis; the cutter axis is parallel to the
     cradle axis, so it lies on the normal line ``M + t n`` at horizontal distance r_c: the blade
@@ -530,9 +727,9 @@ def fit_cutter(
     blade, normal pointing towards the axis).
     """
     ms0 = MachineSettings(
-        member, side, blade, cutter_radius, 20.0, cutter_radius, parabola, 0.0, 0.0, 0.0, 0.0,
-        math.degrees(machine_root_angle), blank_offset, 0.0, 0.0, math.degrees(blank_phase),
-        ratio_of_roll, modified_roll,
+        member, side, blade, cutter_radius, 20.0, cutter_radius, parabola, edge_radius, 0.0, 0.0,
+        0.0, 0.0, math.degrees(machine_root_angle), blank_offset, 0.0, 0.0,
+        math.degrees(blank_phase), ratio_of_roll, modified_roll,
     )  # fmt: skip
     B = blank_placement(ms0)
     P = apply_points(B, point)
@@ -557,6 +754,7 @@ def fit_cutter(
         blade_angle_deg=math.degrees(alpha),
         point_radius_mm=float(rp),
         parabola_per_mm=float(parabola),
+        edge_radius_mm=float(edge_radius),
         radial_setting_mm=float(np.hypot(*centre)),
         cradle_angle_deg=math.degrees(math.atan2(centre[1], centre[0])),
         ref_height_mm=float(P[2]),
@@ -750,7 +948,7 @@ def synthesize(
         M2, n2, t2, th2 = gear_flank_design(blank, side)
         blade2 = "outside" if side == "drive" else "inside"
         gs = fit_cutter("gear", side, blade2, M2, n2, blank.cutter_radius_mm, 0.0, gm2,
-                        math.pi - th2, mc2)  # fmt: skip
+                        math.pi - th2, mc2, edge_radius=blank.edge_radius)  # fmt: skip
         out[f"gear_{side}"] = gs
         env2 = generate(head_cutter(gs), machine_motion(gs), 0.0, 0.0, 0.0, half_width=0.2)
         # ---- into the mesh frame
@@ -778,7 +976,7 @@ def synthesize(
         def settings1(x, side=side, blade1=blade1, M=M, n=n):
             rc, m, C, E = x
             return fit_cutter("pinion", side, blade1, M, -n, rc, targets.pinion_parabola_per_mm,
-                              gm1, math.pi, m, C, E)  # fmt: skip
+                              gm1, math.pi, m, C, E, edge_radius=blank.edge_radius)  # fmt: skip
 
         def residual(x, M=M, bpin=bpin, S_p_target=S_p_target, settings1=settings1):
             ms = settings1(x)

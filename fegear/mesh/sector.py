@@ -22,19 +22,18 @@ Construction (gmsh, OpenCASCADE kernel; :mod:`fegear.mesh.sector_geometry` compu
 4. Faces are named *geometrically*: envelope faces by their cone coordinates, loft faces by the
    nearest section edge (majority vote of a 5 × 5 parametric sample of the face).
 
-Fillets: the involute and face-gear families model the generated fillet (the involute's
-trochoid from the rack tip, the face gear's trace of the shaper's tip edge,
-:mod:`fegear.geometry.face_gear_fillet`) and the root between the fillets of a tooth space. Each
-section carries them as one edge per space half (space middle → root → fillet → fillet limit)
-through 25 exact points at about equal arc lengths (:func:`~.sector_geometry._root_fillet`), so
-that the loft stays regular where the face-gear fillet shrinks from 7 mm at the inner end to a
-point at 555 mm (where the shaper tip rolls on the root plane); fillet nodes lie within 0.011 mm
-of the exact fillet on the level-0 seed sector (``tests/test_mesh_sector.py``). The spiral bevel
-stops at the fillet limit and closes each tooth space with a *root blend*: a cubic Hermite curve
-from the flank bottom (flank tangent) to the space middle on the root surface (tangent along the
-root), tangents scaled to the chord (given to OCC as the equivalent Bézier, so the volume
-estimate can use the same curve), lofted along the face. It is not the generated fillet; it is
-there to carry the tooth-root compliance.
+Fillets: every family models the generated fillet (the involute's trochoid from the rack tip,
+the face gear's trace of the shaper's tip edge, :mod:`fegear.geometry.face_gear_fillet`, the
+spiral bevel's envelope of the blade's edge radius, :mod:`fegear.geometry.spiral_bevel`) and the
+root between the fillets of a tooth space. Each section carries them as one edge per space half
+(space middle → root → fillet → fillet limit) through 25 exact points at about equal arc lengths
+(:func:`~.sector_geometry._root_fillet`), so that the loft stays regular where the face-gear
+fillet shrinks from 7 mm at the inner end to a point at 555 mm (where the shaper tip rolls on
+the root plane); fillet nodes lie within 0.011 mm of the exact fillet on the level-0 seed sector
+(``tests/test_mesh_sector.py``); the spiral bevel's (an edge radius of 0.81 mm, fillets about
+1 mm high) within 1e-5 of the local element size. (A family without a generated fillet would
+close each tooth space with a *root blend*: a cubic Hermite curve from the flank bottom to the
+space middle on the root surface, given to OCC as the equivalent Bézier; none is left.)
 
 Boundary conditions meant for this mesh (applied by the compliance stage): ``bore`` (involute
 and spiral bevel members: bore, or rim-bottom cone ``rim_modules · m`` below the root cone) or
@@ -98,8 +97,9 @@ Array = NDArray[np.float64]
 FINE = (0.45, 0.32, 0.22, 0.16, 0.11)
 #: coarse (far-field) element size per level, in modules
 COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
-#: 5: generated face-gear fillet; 4: flat surface triangles re-meshed; 3: zone seeds interpolated
-_VERSION = "sector-5"
+#: 6: generated spiral-bevel fillet; 5: generated face-gear fillet; 4: flat surface triangles
+#: re-meshed; 3: zone seeds interpolated
+_VERSION = "sector-6"
 
 
 class FlankZone(NamedTuple):

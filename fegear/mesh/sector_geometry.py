@@ -21,9 +21,9 @@ member, everything that construction needs, in the member frame (axis z):
   (:func:`section_integral_volume`), and closest points on the analytic flank
   (:func:`flank_distance`).
 
-Spiral bevel flanks are evaluated with the member's exact native evaluator
-(:meth:`~fegear.geometry.spiral_bevel.SpiralBevelMember.native_flank`, the same envelope to
-~1e-13 mm, ~100× faster than ``point_normal``).
+Spiral bevel flanks and fillets are evaluated with the member's exact native evaluators
+(:meth:`~fegear.geometry.spiral_bevel.SpiralBevelMember.flank_points`: the blade's and the edge
+radius's envelopes, the same surfaces to ~1e-13 mm, ~100× faster than ``point_normal``).
 
 Teeth of the sector are numbered ``j = 0 … n−1`` in the direction of +θ; sector tooth ``j`` is
 member tooth ``k = j − n//2`` (tooth ``k`` is tooth 0 turned by ``k τ`` about z), so the centre
@@ -167,8 +167,7 @@ class SectorFrame:
     def flank_points(self, side: Side, u: Array, v: Array) -> Array:
         """Exact flank points ``(..., 3)`` of member tooth 0 at ``(u, v)`` (broadcast)."""
         if isinstance(self.member, SpiralBevelMember):
-            nf = self.member.native_flank(side)
-            return nf.evaluate(*nf.native(u, v))[0]
+            return self.member.flank_points(side, u, v)[0]
         return self.member.point_normal(side, u, v)[0]
 
     def tooth_points(self, side: Side, k: Array | int, u: Array, v: Array) -> Array:
@@ -244,9 +243,9 @@ def sector_frame(member: GeneratedMember, rim_modules: float = 3.0) -> SectorFra
         # plus side: the side whose mean point has the larger polar angle (one exact envelope
         # point per side, 15 ms; building a side's native evaluator for it took 0.8 s, for the
         # unloaded side on every warm run)
-        um, vm = member.mean_parameters()
         ang = {}
         for s in ("drive", "coast"):
+            um, vm = member.mean_parameters(s)
             p = member.point_normal(s, np.array([um]), np.array([vm]))[0][0]
             ang[s] = math.atan2(p[1], p[0])
         plus: Side = "drive" if ang["drive"] > ang["coast"] else "coast"
@@ -258,7 +257,7 @@ def sector_frame(member: GeneratedMember, rim_modules: float = 3.0) -> SectorFra
             loft_bottom=Line(bot.a - 0.5 * m, bot.b), L_start=A0 - F, L_end=A0,
             L_range=(A0 - F - 0.04 * F, A0 + 0.04 * F), n_sections=9,
             u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side=plus,
-            bottom_name="bore", has_fillet=False,
+            bottom_name="bore", has_fillet=True,
         )  # fmt: skip
     raise MeshError(f"no sector geometry for member type {type(member).__name__}")
 
@@ -442,8 +441,8 @@ def section_integral_volume(frame: SectorFrame, n_teeth: int, n_L: int = 21, nu:
     straight parts), Simpson's rule over ``n_L`` sections in ``L``.
 
     Independent of the CAD loft, the trimming and the mesh; it models the *same* solid, so the
-    root of a family without a generated fillet (spiral bevel) is the sector's cubic root blend
-    (:func:`hermite_points`, 41 points), not the generated fillet.
+    root of a family without a generated fillet would be the sector's cubic root blend
+    (:func:`hermite_points`, 41 points); every family now has its generated fillet.
     """
     fr = frame
     M = fr.meridian

@@ -111,11 +111,12 @@ def _row_m0(r: CycleResult) -> int:
     return int(np.nonzero((r.pairs[:, 0] == 0) & (r.pairs[:, 1] == 0))[0][0])
 
 
-def pattern_centre(r: CycleResult, gear, n1: int) -> tuple[float, float]:
-    """Mean ``(L, h)`` (mm) of the gear contact path over the positions with ``|φ1| < π/N1``."""
+def pattern_centre(r: CycleResult, gear, n1: int, side: str = "drive") -> tuple[float, float]:
+    """Mean ``(L, h)`` (mm) of the gear contact path over the positions with ``|φ1| < π/N1``
+    (``h`` from the ``side`` flank's coordinates: ``u`` is measured from its own fillet limit)."""
     m = r.has_contact & (np.abs(r.phi1) < math.pi / n1 - 1e-12)
     u, v = r.gear_uv[m, 0], r.gear_uv[m, 1]
-    return float(np.mean(v)), float(np.mean(gear.height(u, v)))
+    return float(np.mean(v)), float(np.mean(gear.height(u, v, side)))
 
 
 def first_order_te_shift(pair, side: str, errors: InstallationErrors) -> float:
@@ -152,7 +153,7 @@ def error_effects(
     n1 = pair.blank.n1
     phi = cycle_angles(n1, n_positions)
     ref = run_tca(pair.pinion, pair.gear, spiral_bevel_assembly(pair, side), opt, phi1=phi)
-    L0, h0 = pattern_centre(ref, pair.gear, n1)
+    L0, h0 = pattern_centre(ref, pair.gear, n1, side)
     out: dict[str, ErrorEffect] = {}
     runs: dict[str, CycleResult] = {}
     for label, e in cases.items():
@@ -164,7 +165,7 @@ def error_effects(
             out[label] = ErrorEffect(label, e, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                                      first_order_te_shift(pair, side, e), 0)  # fmt: skip
             continue
-        L, h = pattern_centre(r, pair.gear, n1)
+        L, h = pattern_centre(r, pair.gear, n1, side)
         xv, tv, amp, _ = te_parabola(r, n1)
         out[label] = ErrorEffect(
             label=label,

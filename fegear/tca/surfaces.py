@@ -14,7 +14,8 @@ coordinates* ``(u, v)`` (profile × face, with :class:`~fegear.geometry.surface.
   ch. 10). Agrees with the generated surface to ~1e-12 mm (tested).
 - :class:`SpiralBevelMap`: face-milled spiral bevel, native ``(s, θ)`` cutter parameters, ψ from
   the equation of meshing by Newton from a tabulated predictor
-  (:class:`~fegear.geometry.spiral_bevel.NativeFlank`); analytic Jacobian.
+  (:class:`~fegear.geometry.spiral_bevel.NativeFlank`); analytic Jacobian; flank coordinates:
+  the fraction of the working height above the fillet-limit curve, and the cone distance.
 - :class:`FaceGearMap`: face gear with γ = 90°: Litvin's closed form (Litvin & Fuentes 2004
   §19.3; :func:`fegear.geometry.face_gear.closed_form_point`), native ``(t, ψ)`` = shaper roll and
   shaper angle; flank coordinates: the fraction of the working height between the fillet-limit
@@ -220,8 +221,10 @@ class SpiralBevelMap(FlankMap):
     Evaluation by :class:`~fegear.geometry.spiral_bevel.NativeFlank`: the exact envelope, ψ from
     the equation of meshing by Newton from a tabulated predictor (agrees with the engine's
     ``point_normal`` to ~1e-13 mm, tested). The Jacobian is analytic (implicit-function theorem),
-    not a finite difference. Flank coordinates ``(u, v)``: fraction of the working height and
-    cone distance ``L`` (mm).
+    not a finite difference. Flank coordinates ``(u, v)``: the fraction of the working height
+    between this side's fillet-limit curve (where the blade meets its edge radius) and the face
+    cone, and the cone distance ``L`` (mm); a point below the fillet limit has ``u < 0`` and is
+    outside the working surface (the fillet itself is not a contact surface of the TCA).
     """
 
     def _nf(self):
@@ -289,6 +292,6 @@ def flank_map(member, side: str, generic: bool = False) -> FlankMap:
 
     if isinstance(member, SpiralBevelMember) and not generic:
         # steps of the finite-difference curvatures (ellipse): 50 steps = 0.01 mm, 1e-3 rad
-        return SpiralBevelMap(member, side, member.boundaries(), (2e-4, 2e-5))
+        return SpiralBevelMap(member, side, member.boundaries(side), (2e-4, 2e-5))
     bd = member.boundaries()
     return GenericFlankMap(member, side, bd, (1e-6, 1e-5))
