@@ -1,14 +1,19 @@
-"""Loaded TE amplitude and contact ratio of the seed face gear against the load (issue 6).
+"""Loaded TE amplitude and contact ratio of the seed face gear against the load, every fidelity.
 
 Run: ``python docs/ltca/te_vs_load.py`` (fe, hertz and hybrid at level 0, 25 positions, 10 … 200 %
-of the seed load 3e6 N·mm). Writes ``te_vs_load.png`` and ``te_vs_load.md`` here. The TE over the
-cycle is drawn for ``hybrid``: the fidelity that is converged in its mesh level on this gear
-(README, "Fidelities"; ``fe`` level 0 smears the 0.5 mm wide patch over 2.9 mm cells).
+of the seed load 3e6 N·mm, the whole generated flank). Writes ``te_vs_load.png`` and
+``te_vs_load.md`` here. The headlines are those of ``summary.json``
+(:meth:`fegear.ltca.results.LoadedCycle.headline`): the TE peak-to-peak over the usable positions
+(a position whose loaded patch the cells do not resolve is left out and counted), p_max away from
+the flank edges, the edge value beside it. The TE over the cycle is drawn for ``hybrid``: the
+fidelity that resolves the 0.5 mm wide patch at level 0 (``fe`` level 0 smears it over 2.9 mm
+cells; ``hertz`` is a closed-form law per pair on a lumped compliance).
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -23,16 +28,32 @@ from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember  # noqa: E4
 from fegear.ltca import LTCAOptions, build_models, run_ltca  # noqa: E402
 
 HERE = Path(__file__).parent
-LOADS = np.array([3e5, 5e5, 1.5e6, 3e6, 6e6])  # N·mm on the face gear
 NOTE = (
-    "p_max is the largest cell pressure of the cycle, edge contacts included: singular and "
-    "grid-dependent where the hybrid resolves a patch running off the pinion tip (README, "
-    "'Fidelities', for p_max away from the edges)."
+    "How to read it. `hybrid` and `hertz` agree: the loaded contact ratio is the same at every "
+    "load, p_max away from the edges within 2.6 % (Hertz theory on both: the closed form per "
+    "pair against the half-space near field of the hybrid), the mean loaded TE within 11 %; the "
+    "TE peak-to-peak within 0.09-0.34″, 8-68 % of the hybrid's (the most at the light loads, "
+    "where it is small): `hertz` "
+    "lumps each tooth pair into one spring at its closest point, so it does not see the "
+    "entering pair's corner contact at the face-gear tip that shapes the hybrid TE between "
+    "-4 and 0° (the edge column: the singular corner pressure of the hybrid, the lumped law's "
+    "nominal value for `hertz`). `fe` level 0 reports no TE peak-to-peak and no p_max: its "
+    "cells are element faces (2.9 mm) on a patch 0.5 mm wide at every position, so every "
+    "position is degenerate; its mean TE goes from 17 % less lag than hybrid's at the lightest "
+    "load to 26 % more at 3e6 N·mm. On the flank cut at "
+    "one height (before the whole generated flank) `hertz` gave 8.4″ at 6e6 N·mm against 1.0″ "
+    "for `hybrid`: the cut edge, not the gear, set both."
 )
+LOADS = np.array([3e5, 5e5, 1.5e6, 3e6, 6e6])  # N·mm on the face gear
+
+
+def _num(x, fmt: str) -> str:
+    return "—" if x is None else format(x, fmt)
 
 
 def main() -> None:
     logging.basicConfig(level=logging.WARNING)
+    t_start = time.perf_counter()
     fg = FaceGearMember(FaceGearDesign())
     pin = fg.pinion()
     asm = face_gear_assembly(fg, InstallationErrors(), pin)
@@ -45,21 +66,13 @@ def main() -> None:
         pp, cr, te = [], [], []
         for T in LOADS:
             c = run_ltca(pin, fg, asm, T, o, models=models)
-            pp.append(c.te_pp_loaded_arcsec)
+            h = c.headline()
+            pp.append(np.nan if h.te_pp_loaded_arcsec is None else h.te_pp_loaded_arcsec)
             cr.append(c.contact_ratio_loaded)
             te.append(c.te_loaded_arcsec)
-            rows.append(
-                (
-                    fid,
-                    T,
-                    c.te_pp_unloaded_arcsec,
-                    c.te_pp_loaded_arcsec,
-                    float(np.mean(c.te_loaded_arcsec)),
-                    c.contact_ratio_loaded,
-                    c.p_max_MPa,
-                )
-            )
-        ax[0].plot(LOADS / 1e6, pp, mark, label=fid)
+            rows.append((fid, T, h, float(np.mean(c.te_loaded_arcsec))))
+        lab = fid if np.isfinite(pp).any() else f"{fid}: not reported (cells wider than patch)"
+        ax[0].plot(LOADS / 1e6, pp, mark, label=lab)
         ax[1].plot(LOADS / 1e6, cr, mark, label=fid)
         if fid == "hybrid":
             for T, t in zip(LOADS, te, strict=True):
@@ -73,17 +86,28 @@ def main() -> None:
     for a in ax:
         a.grid(alpha=0.3)
         a.legend(fontsize=7)
-    fig.suptitle("Seed face gear, level 0: loaded TE and contact ratio against the load")
+    fig.suptitle("Seed face gear (whole flank), level 0: loaded TE and contact ratio against load")
     fig.tight_layout()
     fig.savefig(HERE / "te_vs_load.png")
     lines = [
-        "| fidelity | T2 (N·mm) | TE p-p unloaded (″) | TE p-p loaded (″) | mean loaded TE (″) "
-        "| loaded contact ratio | p_max (MPa) |",
-        "|---|---|---|---|---|---|---|",
+        "| fidelity | T2 (N·mm) | TE p-p unloaded (″) | TE p-p loaded (″) | positions used "
+        "| mean loaded TE (″) | loaded contact ratio | p_max away from edges (MPa) "
+        "| edge p_max (MPa), edge |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    lines += [f"| {f} | {T:.3g} | {a:.3f} | {b:.3f} | {m:.2f} | {r:.2f} | {p:.0f} |"
-              for f, T, a, b, m, r, p in rows]  # fmt: skip
-    lines += ["", NOTE]
+    for f, T, h, mean in rows:
+        edge = (
+            "—"
+            if h.p_max_edge_MPa is None
+            else (f"{h.p_max_edge_MPa:.0f}, {', '.join(h.p_max_edge_edges)}")
+        )
+        lines.append(
+            f"| {f} | {T:.3g} | {_num(h.te_pp_unloaded_arcsec, '.3f')} | "
+            f"{_num(h.te_pp_loaded_arcsec, '.3f')} | {h.te_pp_positions_used}/{h.n_positions} | "
+            f"{mean:.2f} | {h.contact_ratio_loaded:.2f} | {_num(h.p_max_MPa, '.0f')} | {edge} |"
+        )
+    wall = time.perf_counter() - t_start
+    lines += ["", NOTE, "", f"Command: `python docs/ltca/te_vs_load.py` ({wall:.0f} s, 2 cores)."]
     (HERE / "te_vs_load.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines))
 
