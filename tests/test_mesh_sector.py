@@ -2,7 +2,8 @@
 
 Meshes are cached (``meshes/cache`` or ``$FEGEAR_CACHE``); a cold run meshes the coarsest levels
 only. The default suite checks the FZG pinion and the face gear; the face-gear pinion and the
-spiral bevel pinion and gear run under ``-m slow`` (the bevel pair design alone takes ~10 s).
+spiral bevel pinion and gear (with their generated fillets: the envelopes of the blades' edge
+radii) run under ``-m slow`` (the bevel pair design alone takes ~15 s).
 """
 
 from __future__ import annotations
@@ -96,6 +97,10 @@ def test_named_groups(sector: SectorMesh):
         assert len(m.boundaries[name]) == len(tri), name
     # quality gate held (the mesher raises below it)
     assert sector.diagnostics["min_sicn"] >= 0.03
+    if sector.family == "spiral_bevel":
+        # issue 20: the bevel sectors with their generated fillets mesh at the first attempt
+        # (HXT; measured min SICN 0.14 pinion / 0.19 gear)
+        assert sector.diagnostics["attempts"] == 1 and sector.diagnostics["algorithm3d"] == 10
 
 
 def _local_size(mesh: SectorMesh, name: str) -> tuple[np.ndarray, np.ndarray]:

@@ -346,8 +346,7 @@ class SpiralBevelMember:
             L = np.linspace(A0 - F, A0, n_L)
             phi = {}
             for side in ("drive", "coast"):
-                nf = self.native_fillet(side)
-                p = nf.evaluate(*nf.native(-np.ones_like(L), L))[0]
+                p = self._fillet_solve(side, -np.ones_like(L), L)[0].points  # engine: 9 points
                 phi[side] = np.arctan2(p[:, 1], p[:, 0])
             plus, minus = ("drive", "coast")
             if phi["drive"][0] < phi["coast"][0]:

@@ -31,9 +31,10 @@ root between the fillets of a tooth space. Each section carries them as one edge
 fillet shrinks from 7 mm at the inner end to a point at 555 mm (where the shaper tip rolls on
 the root plane); fillet nodes lie within 0.011 mm of the exact fillet on the level-0 seed sector
 (``tests/test_mesh_sector.py``); the spiral bevel's (an edge radius of 0.81 mm, fillets about
-1 mm high) within 1e-5 of the local element size. (A family without a generated fillet would
-close each tooth space with a *root blend*: a cubic Hermite curve from the flank bottom to the
-space middle on the root surface, given to OCC as the equivalent Bézier; none is left.)
+1 mm high, 13 points per space half) within 2e-5 of the local element size. (A family without a
+generated fillet would close each tooth space with a *root blend*: a cubic Hermite curve from the
+flank bottom to the space middle on the root surface, given to OCC as the equivalent Bézier;
+none is left.)
 
 Boundary conditions meant for this mesh (applied by the compliance stage): ``bore`` (involute
 and spiral bevel members: bore, or rim-bottom cone ``rim_modules · m`` below the root cone) or
