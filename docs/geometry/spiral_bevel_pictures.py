@@ -1,4 +1,5 @@
-"""Pictures of the reference spiral bevel pair (DESIGN §4): flank grids, contact path, TE.
+"""Pictures of the reference spiral bevel pair (DESIGN §4): flank grids, contact path, TE,
+generated fillets.
 
 Run: ``python docs/geometry/spiral_bevel_pictures.py`` (writes ``spiral_bevel_*.png`` here).
 """
@@ -75,6 +76,60 @@ def flank_vtk(pair: SpiralBevelPair, member: str) -> Path:
     return out
 
 
+def fillet_sections(pair: SpiralBevelPair) -> Path:
+    """One tooth space of each member in the back-cone sections ``L = const`` at the toe, the
+    mean and the heel: flanks (``u`` 0 → 1) and generated fillets (``u`` −1 → 0) of the two
+    flanks facing the space, the root cone between the fillet bottoms, the fillet limits (dots)
+    and the working depth the mate's tip reaches (dashed). Coordinates: arc length from the
+    middle of the space along the section's pitch circle, ``ρ_p (φ − φ_mid)`` (mm), and the
+    height ``h`` above the pitch cone."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.5), dpi=90)
+    b = pair.blank
+    A0, F = b.outer_cone_distance, b.face_width_mm
+    u = np.concatenate([np.linspace(-1.0, 0.0, 25), np.linspace(0.0, 1.0, 41)[1:]])
+    for ax, m in zip(axes, (pair.pinion, pair.gear), strict=True):
+        g = m.pitch_angle
+        for L, colour in ((A0 - F, "tab:blue"), (A0 - F / 2, "tab:green"), (A0, "tab:red")):
+            ends = {}
+            for side in ("drive", "coast"):
+                p, _ = m.flank_points(side, u, np.full_like(u, L))
+                rho = np.hypot(p[:, 0], p[:, 1])
+                h = rho * math.cos(g) - p[:, 2] * math.sin(g)
+                phi = np.arctan2(p[:, 1], p[:, 0])
+                ends[side] = (phi, h, rho)
+            # the space between the +θ flank of tooth 0 and the −θ flank of tooth 1
+            plus = "drive" if ends["drive"][0][-1] > ends["coast"][0][-1] else "coast"
+            minus = "coast" if plus == "drive" else "drive"
+            r0 = L * math.sin(g)  # the pitch-cone radius at L: the arc-length scale
+            mid = 0.5 * (ends[plus][0][0] + ends[minus][0][0] + m.tooth_angle)  # space middle
+            xp = (ends[plus][0] - mid) * r0
+            xm = (ends[minus][0] + m.tooth_angle - mid) * r0
+            for x, side in ((xp, plus), (xm, minus)):
+                h = ends[side][1]
+                ax.plot(x[25:], h[25:], "-", color=colour, lw=1.2)
+                ax.plot(x[:25], h[:25], "-", color=colour, lw=2.4)
+                ax.plot(x[24], h[24], "o", color=colour, ms=4)
+            ax.plot([xp[0], xm[0]], [ends[plus][1][0], ends[minus][1][0]], "-", color=colour,
+                    lw=2.4, label=f"L = {L:.1f} mm")  # fmt: skip
+            hw = float(b.flank_heights(m.index, L)[0])
+            ax.plot([xp.min(), xm.max()], [hw, hw], "--", color=colour, lw=0.8)
+        ax.set_title(f"{m.name}: one tooth space (thick: fillets and root cone)")
+        ax.set_xlabel("arc length ρ_p (φ − φ_space middle) at the section (mm)")
+        ax.set_ylabel("height h above the pitch cone (mm)")
+        ax.set_aspect("equal")
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(
+        f"Generated fillets (edge radius {pair.settings.gear_drive.edge_radius_mm:.3f} mm); "
+        "dots: fillet limits, dashed: the mate's face cone"
+    )
+    fig.tight_layout()
+    out = HERE / "spiral_bevel_fillet.png"
+    fig.savefig(out)
+    plt.close(fig)
+    return out
+
+
 def main() -> None:
     logging.basicConfig(level=logging.INFO)
     pair = SpiralBevelPair.design()
@@ -98,6 +153,7 @@ def main() -> None:
     for member in ("pinion", "gear"):
         log.info("wrote %s", flank_grids(pair, member, paths[member]))
         log.info("wrote %s", flank_vtk(pair, member))
+    log.info("wrote %s", fillet_sections(pair))
 
 
 if __name__ == "__main__":
