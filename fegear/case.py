@@ -84,6 +84,95 @@ class HertzCase:
     study_levels: tuple[int, ...]
     source: str
 
+    def to_document(self) -> dict[str, Any]:
+        """The case as a case-file document (the TOML tables as dicts): :func:`parse_case` of
+        it gives this case back."""
+        s = self.scene
+        return {
+            "case": {"kind": "hertz_scene", "name": self.name},
+            "load": {"force_N": s.force_N},
+            "roller": {
+                "radii_mm": list(s.roller_radii_mm),
+                "half_length_mm": s.roller_half_length_mm,
+                "E_MPa": s.E_roller_MPa,
+                "nu": s.nu_roller,
+            },
+            "block": {
+                "half_size_mm": s.block_half_size_mm,
+                "height_mm": s.block_height_mm,
+                "E_MPa": s.E_block_MPa,
+                "nu": s.nu_block,
+            },
+            "mesh": {"level": self.level, "symmetry": s.symmetry, "grid_margin": s.grid_margin},
+            "solver": {
+                "backend": self.backend,
+                "fidelity": self.fidelity,
+                "fe_level": self.fe_level,
+            },
+            "study": {"levels": list(self.study_levels)},
+        }
+
+    def replace(self, **changes: Any) -> HertzCase:
+        """A new, validated case with some fields changed (the case itself is frozen).
+
+        Parameters
+        ----------
+        **changes
+            Case-file keys as ``section_key``-free names: ``name``, ``level``, ``backend``,
+            ``fidelity``, ``fe_level``, ``study_levels``, ``force_N`` (N), ``roller_radii_mm``
+            (``(Rx, Ry)``, mm), ``roller_half_length_mm``, ``block_half_size_mm``,
+            ``block_height_mm`` (mm), ``E_roller_MPa``, ``E_block_MPa`` (MPa), ``nu_roller``,
+            ``nu_block``, ``symmetry``, ``grid_margin``, and ``source``.
+
+        Raises
+        ------
+        InputError
+            An unknown field, or a value the case file would refuse, named as in the case file.
+        """
+        from fegear.io.gear_case import _plain
+
+        doc = self.to_document()
+        source = self.source
+        for key, value in changes.items():
+            value = _plain(value)
+            if key == "source":
+                source = str(value)
+                continue
+            if key not in _HERTZ_FIELDS:
+                known = sorted([*_HERTZ_FIELDS, "source"])
+                close = difflib.get_close_matches(key, known, n=1, cutoff=0.5)
+                raise InputError(
+                    key,
+                    value,
+                    f"one of the fields {known}",
+                    f"did you mean {close[0]!r}?" if close else "",
+                )
+            section, name = _HERTZ_FIELDS[key]
+            doc[section][name] = value
+        return parse_hertz_case(doc, source=source)
+
+
+#: :meth:`HertzCase.replace` field -> (case-file section, key)
+_HERTZ_FIELDS = {
+    "name": ("case", "name"),
+    "force_N": ("load", "force_N"),
+    "roller_radii_mm": ("roller", "radii_mm"),
+    "roller_half_length_mm": ("roller", "half_length_mm"),
+    "E_roller_MPa": ("roller", "E_MPa"),
+    "nu_roller": ("roller", "nu"),
+    "block_half_size_mm": ("block", "half_size_mm"),
+    "block_height_mm": ("block", "height_mm"),
+    "E_block_MPa": ("block", "E_MPa"),
+    "nu_block": ("block", "nu"),
+    "level": ("mesh", "level"),
+    "symmetry": ("mesh", "symmetry"),
+    "grid_margin": ("mesh", "grid_margin"),
+    "backend": ("solver", "backend"),
+    "fidelity": ("solver", "fidelity"),
+    "fe_level": ("solver", "fe_level"),
+    "study_levels": ("study", "levels"),
+}
+
 
 def _type_name(t: type | tuple[type, ...]) -> str:
     if t is _NUM:

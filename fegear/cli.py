@@ -12,6 +12,15 @@ With no CASE it runs the built-in seed face-gear case (``cases/face_gear_nominal
 N1 25, m 6.35 mm, 25°, pinion torque 350.14 N·m, hybrid level 0, 25 positions; under a minute
 cold on 2 cores, the sector meshes and compliance operators are then cached).
 
+``fegear sweep CASE... [--grid KEY=START:STOP:N]`` runs several cases or a grid
+(:mod:`fegear.sweep`); ``fegear cache info | clear [--kind K]`` shows or empties the
+mesh/operator cache (:mod:`fegear.mesh.cache`: the per-user cache folder, or ``$FEGEAR_CACHE``);
+``fegear plot FOLDER [--member gear|pinion]`` draws the bearing pattern over the cycle on a
+member's flank from a run's flank views.
+
+The command is a layer over the Python API (:mod:`fegear.api`): ``fegear run`` is
+``fegear.run(case, ...)`` then ``result.write(out)``, with the progress and the report printed.
+
 Progress goes to stderr (stages and positions); ``-q`` keeps only warnings and errors. Warnings
 that change the meaning of a headline (positions left out of the TE peak-to-peak, a p_max not
 reported, a contact ratio below 1, contact lost, ``fe`` cells wider than the patch) are printed
@@ -28,11 +37,17 @@ import logging
 import os
 import sys
 import time
+from pathlib import Path
 
 from fegear import __version__
 from fegear.errors import FegearError, InputError
 
-__all__ = ["main"]
+__all__ = ["main", "parser"]
+
+
+def parser() -> argparse.ArgumentParser:
+    """The command's argument parser (also what checks the command lines of the docs)."""
+    return _parser()
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -81,7 +96,11 @@ def _parser() -> argparse.ArgumentParser:
         "errors.dgamma_deg=-0.04:0.04:5 or load.torque2_Nm=100:400:4; repeat for a product",
     )
     s.add_argument("--out", default="sweep", help="sweep folder (default: ./sweep)")
-    s.add_argument("--fidelity", help="hybrid | fe | hertz | tca; overrides the cases")
+    s.add_argument(
+        "--fidelity",
+        help="hybrid (the default of every case) | fe | hertz | tca (unloaded, rigid); "
+        "overrides the cases",
+    )
     s.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the cases")
     s.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     s.add_argument(
@@ -91,11 +110,44 @@ def _parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--nominal", help="reference item of the comparison (default: no errors)")
     s.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    c = sub.add_parser(
+        "cache",
+        help="the mesh/operator cache: where it is and what it holds, or clear it",
+        description="The artefact cache (sector meshes, compliance operators, TCA) is in the "
+        "per-user cache folder of the platform, or in $FEGEAR_CACHE if set.",
+    )
+    csub = c.add_subparsers(dest="cache_command", required=True)
+    csub.add_parser("info", help="where the cache is, its size per kind and number of files")
+    cc = csub.add_parser("clear", help="delete the cached artefacts (all, or one kind)")
+    cc.add_argument("--kind", help="only this kind (a folder name shown by `fegear cache info`)")
+    pl = sub.add_parser(
+        "plot",
+        help="the bearing pattern over the cycle on one member's flank, from a run's folder",
+        description="Reads FOLDER/vtk/flank_<member>_*.vtp (fidelity hybrid or fe) and draws the "
+        "largest pressure each point of the flank saw over the cycle, with the working-surface "
+        "outline, as a PNG.",
+    )
+    pl.add_argument("folder", help="output folder of `fegear run` (e.g. out)")
+    pl.add_argument("--member", choices=["gear", "pinion"], default="gear",
+                    help="whose flank (default: gear)")  # fmt: skip
+    pl.add_argument("--png", help="the PNG (default: FOLDER/bearing_pattern_<member>_flank.png)")
+    pl.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     return p
 
 
+#: API argument -> command-line option (the API names its arguments, the command its options)
+_OPTIONS = ("fidelity", "level", "workers", "study", "backend")
+
+
+def _as_option(exc: InputError) -> InputError:
+    """An API argument error renamed to the command-line option (``level`` → ``--level``)."""
+    if exc.field in _OPTIONS:
+        return type(exc)(f"--{exc.field}", exc.value, exc.allowed, exc.detail)
+    return exc
+
+
 def _run(args: argparse.Namespace) -> int:
-    from fegear.case import load_case
+    from fegear.api import load_case
     from fegear.io.gear_case import GearCase
 
     if args.case:
@@ -104,23 +156,21 @@ def _run(args: argparse.Namespace) -> int:
         from fegear.io.seed import seed_case
 
         case = seed_case()
-    if isinstance(case, GearCase):
-        return _run_gear(args, case)
-    return _run_hertz(args, case)
+    try:
+        if isinstance(case, GearCase):
+            return _run_gear(args, case)
+        return _run_hertz(args, case)
+    except InputError as exc:
+        raise _as_option(exc) from exc
 
 
 def _run_gear(args: argparse.Namespace, case) -> int:
-    from dataclasses import replace
-
+    from fegear.api import run
     from fegear.io.files import check_writable_folder
-    from fegear.io.gear_case import build_pair
-    from fegear.io.gear_output import write_gear_outputs
-    from fegear.io.gear_run import report, run_gear_case
+    from fegear.io.gear_run import report
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
-    if args.backend:
-        case = replace(case, backend=args.backend)
     out = check_writable_folder(args.out)  # before any work
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     warned: set[str] = set()
@@ -132,21 +182,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
 
     fid = args.fidelity or case.fidelity
     lvl = case.level if args.level is None else args.level
-    if fid not in ("fe", "hertz", "hybrid", "tca"):
-        raise InputError("--fidelity", fid, "'fe', 'hertz', 'hybrid' or 'tca' for gear pairs")
-    if not 0 <= lvl <= 4:
-        raise InputError("--level", lvl, "an integer in [0, 4]")
-    if args.workers is not None and args.workers < 1:
-        raise InputError("--workers", args.workers, "an integer >= 1")
     t_start = time.perf_counter()
-    pair = build_pair(case)  # bad design data is refused here, before any output
-    say(
-        f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
-        f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
-        + (f", level {lvl}" if fid != "tca" else "")
-        + f", {case.n_positions} positions, out {out}/"
-    )
-    stage_t = {"t": t_start}
     checks = "geometry, assembly and engagement checks (tip clearance, TCA of the positions)"
     if fid in ("fe", "hybrid"):
         layer = " and their layer below the flanks" if fid == "hybrid" else ""
@@ -171,8 +207,17 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             "tca": "[2/3] unloaded TCA over the cycle and engagement checks",
             "writing": "[3/3] writing outputs",
         }
+    stage_t = {"t": t_start, "started": False}
 
     def progress(stage: str, i: int | None, n: int | None) -> None:
+        if not stage_t["started"]:  # the case is valid and its pair built: say what runs
+            stage_t["started"] = True
+            say(
+                f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
+                f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
+                + (f", level {lvl}" if fid != "tca" else "")
+                + f", {case.n_positions} positions, out {out}/"
+            )
         now = time.perf_counter()
         if stage == "positions" and i:
             bar = "#" * int(20 * i / n)
@@ -181,56 +226,61 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         say(f"{labels.get(stage, stage)} ...  ({now - t_start:.1f} s elapsed)")
         stage_t["t"] = now
 
-    run = run_gear_case(
+    result = run(
         case,
         fidelity=args.fidelity,
         level=args.level,
-        progress=progress,
-        pair=pair,
         workers=args.workers,
+        backend=args.backend,
+        progress=progress,
         notify=warn,
     )
     progress("writing", None, None)
-    paths = write_gear_outputs(out, run)
-    rep = report(run)
-    if run.cycle is not None:
-        used = f" over {rep.positions_used} of {rep.n_positions} positions"
+    paths = result.write(out)
+    rep = report(result.run)
+    c = result.cycle
+    if result.fidelity != "tca":
+        used = f" over {c.te_pp_loaded_positions_used} of {c.n_positions} positions"
         say(
-            f"    TE p-p unloaded {_value(rep.te_pp_unloaded_arcsec, '.2f', 'arcsec')}, loaded "
-            f"{_value(rep.te_pp_loaded_arcsec, '.2f', 'arcsec')}"
-            + (used if rep.te_pp_loaded_arcsec is not None else "")
-            + f"; loaded contact ratio {_value(rep.contact_ratio_loaded, '.2f', '')}"
+            f"    TE p-p unloaded {_value(c.te_pp_unloaded_arcsec, '.2f', 'arcsec')}, loaded "
+            f"{_value(c.te_pp_loaded_arcsec, '.2f', 'arcsec')}"
+            + (used if c.te_pp_loaded_arcsec is not None else "")
+            + f"; loaded contact ratio {_value(c.contact_ratio_loaded, '.2f', '')}"
         )
-        if rep.p_max_MPa is not None:
-            k, j = rep.p_max_pair
+        if c.p_max_MPa is not None:
+            k, j = c.p_max_pair
             say(
-                f"    p_max {rep.p_max_MPa:.0f} MPa away from the flank edges (position "
-                f"{rep.p_max_position}, pair ({k}, {j}))"
+                f"    p_max {c.p_max_MPa:.0f} MPa away from the flank edges (position "
+                f"{c.p_max_position}, pair ({k}, {j}))"
             )
-        if rep.p_max_edge_MPa is not None:
-            k, j = rep.p_max_edge_pair
+        if c.p_max_edge_MPa is not None:
+            k, j = c.p_max_edge_pair
             say(
-                f"    edge contact at {len(rep.edge_positions)} of {rep.n_positions} positions: "
-                f"up to {rep.p_max_edge_MPa:.0f} MPa at the {', '.join(rep.p_max_edge_edges)} "
-                f"(position {rep.p_max_edge_position}, pair ({k}, {j})): singular, "
-                "grid-dependent (cycle.p_max_edge_MPa)"
+                f"    edge contact at {len(c.positions_with_edge_contact)} of {c.n_positions} "
+                f"positions: up to {c.p_max_edge_MPa:.0f} MPa at the "
+                f"{', '.join(c.p_max_edge_edges)} (position {c.p_max_edge_position}, pair ({k}, "
+                f"{j})): singular, grid-dependent (cycle.p_max_edge_MPa)"
             )
     else:
-        say(f"    unloaded TE p-p {_value(rep.te_pp_unloaded_arcsec, '.2f', 'arcsec')} (TCA only)")
-    cp = run.engagement.path if run.engagement is not None else None
-    if cp is not None:
+        say(f"    unloaded TE p-p {_value(c.te_pp_unloaded_arcsec, '.2f', 'arcsec')} (TCA only)")
+    ch = result.checks
+    if ch.contact_ratio_unloaded is not None:
+        start, end = ch.path_ends
         say(
-            f"    unloaded contact ratio {cp.contact_ratio:.3f}: one pair's path "
-            f"{cp.length_mm:.1f} mm on the {run.pair.gear.name.replace('_', '-')} flank, from "
-            f"{cp.start_limit.replace(':', ' ')} to {cp.end_limit.replace(':', ' ')}"
+            f"    unloaded contact ratio {ch.contact_ratio_unloaded:.3f}: one pair's path "
+            f"{ch.path_length_mm:.1f} mm on the {result.run.pair.gear.name.replace('_', '-')} "
+            f"flank, from {start.replace(':', ' ')} to {end.replace(':', ' ')}"
         )
     for w in rep.warnings:
         warn(w)
-    n_other = sum(bool(p.warnings) for p in run.cycle.positions) if run.cycle is not None else 0
+    cyc = result.run.cycle
+    n_other = sum(bool(p.warnings) for p in cyc.positions) if cyc is not None else 0
     if n_other:
         say(f"    {n_other} positions with solver notes (summary.json: positions[i].warnings)")
     kinds = (
-        "summary.json, cycle.pvd, vtk/, *.png" if run.cycle is not None else "summary.json, *.png"
+        "summary.json, cycle.pvd, vtk/, *.png"
+        if result.fidelity != "tca"
+        else "summary.json, *.png"
     )
     say(f"wrote {len(paths)} files to {out}/ ({kinds}) in {time.perf_counter() - t_start:.1f} s")
     return 0
@@ -244,67 +294,133 @@ def _value(x: float | None, fmt: str, unit: str) -> str:
 
 
 def _run_hertz(args: argparse.Namespace, case) -> int:
-    from fegear.convergence import observed_rate
+    from fegear.api import run
     from fegear.io.files import check_writable_folder
-    from fegear.io.hertz_output import write_hertz_outputs
-    from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
 
-    if args.backend not in (None, "auto", "pardiso", "superlu"):
-        raise InputError("--backend", args.backend, "'auto', 'pardiso' or 'superlu'")
-    if args.fidelity not in (None, "fe", "hybrid"):
-        raise InputError("--fidelity", args.fidelity, "'fe' or 'hybrid' for the Hertz scene")
-    level = case.level if args.level is None else args.level
-    if not 0 <= level < len(CELLS_ACROSS_MINOR):
-        raise InputError("--level", level, f"an integer in [0, {len(CELLS_ACROSS_MINOR) - 1}]")
-    backend = args.backend or case.backend
-    fidelity = args.fidelity or case.fidelity
-    kw = {"backend": backend, "fidelity": fidelity, "fe_level": case.fe_level}
-    study_levels = case.study_levels
+    study = None
     if args.study:
         try:
-            study_levels = tuple(sorted({int(x) for x in args.study.split(",")}))
+            study = tuple(sorted({int(x) for x in args.study.split(",")}))
         except ValueError as exc:
             raise InputError("--study", args.study, "comma-separated integers") from exc
     out = check_writable_folder(args.out)  # before any work
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr))
-    say(
-        f"fegear {__version__}: case {case.name!r} ({case.source}), fidelity {fidelity}, "
-        f"level {level}, out {out}/"
-    )
-    study = []
-    for i, lv in enumerate(study_levels):
-        t0 = time.perf_counter()
-        say(f"[study {i + 1}/{len(study_levels)}] level {lv} ...")
-        res = run_level(case.scene, lv, **kw)
+    fidelity = args.fidelity or case.fidelity
+    level = case.level if args.level is None else args.level
+    levels = case.study_levels if study is None else study
+    clock = {"t": time.perf_counter(), "started": False}
+
+    def progress(stage: str, i: int | None, n: int | None) -> None:
+        if not clock["started"]:
+            clock["started"] = True
+            say(
+                f"fegear {__version__}: case {case.name!r} ({case.source}), fidelity "
+                f"{fidelity}, level {level}, out {out}/"
+            )
+        clock["t"] = time.perf_counter()
+        if stage == "study":
+            say(f"[study {i}/{n}] level {levels[i - 1]} ...")
+        else:
+            say(f"[run] level {level}: meshes, stiffness, compliance, contact, fields ...")
+
+    res = run(
+        case, fidelity=args.fidelity, level=args.level, backend=args.backend, study=study,
+        progress=progress,
+    )  # fmt: skip
+    for r in res.study:
         say(
-            f"    p0 {res.p0_MPa:8.1f} MPa ({res.error('p0'):+.2%})  a {res.a_mm:.4f} mm "
-            f"({res.error('a'):+.2%})  b {res.b_mm:.4f} mm ({res.error('b'):+.2%})  "
-            f"DOFs {sum(res.dofs.values())}  {time.perf_counter() - t0:.1f} s"
+            f"    level {r.level}: p0 {r.p0_MPa:8.1f} MPa ({r.error('p0'):+.2%})  a "
+            f"{r.a_mm:.4f} mm ({r.error('a'):+.2%})  b {r.b_mm:.4f} mm ({r.error('b'):+.2%})  "
+            f"DOFs {sum(r.dofs.values())}  {sum(r.seconds.values()):.1f} s"
         )
-        study.append(res)
-    rate = {}
-    if len(study) >= 2:
-        h = [r.cell_size_mm for r in study]
-        for key in ("p0", "a", "b"):
-            try:
-                rate[key] = observed_rate(h, [r.error(key) for r in study])
-            except InputError:
-                pass
-        say("observed rates: " + ", ".join(f"{k} {v:.2f}" for k, v in rate.items()))
-    say(f"[run] level {level}: meshes, stiffness, compliance, contact, fields ...")
-    t0 = time.perf_counter()
-    res = run_level(case.scene, level, with_fields=True, **kw)
+    if res.rates:
+        say("observed rates: " + ", ".join(f"{k} {v:.2f}" for k, v in res.rates.items()))
     for w in res.warnings:
         say(f"warning: {w}")
     say(
-        f"    p0 {res.p0_MPa:.1f} MPa (Hertz {res.hertz.p0_MPa:.1f}, {res.error('p0'):+.2%}), "
-        f"a {res.a_mm:.4f} mm ({res.error('a'):+.2%}), b {res.b_mm:.4f} mm "
-        f"({res.error('b'):+.2%}), {res.n_active} active cells, "
-        f"{time.perf_counter() - t0:.1f} s"
+        f"    p0 {res.p0_MPa:.1f} MPa (Hertz {res.hertz_p0_MPa:.1f}, {res.errors['p0']:+.2%}), "
+        f"a {res.a_mm:.4f} mm ({res.errors['a']:+.2%}), b {res.b_mm:.4f} mm "
+        f"({res.errors['b']:+.2%}), {res.level_result.n_active} active cells, "
+        f"{time.perf_counter() - clock['t']:.1f} s"
     )
-    paths = write_hertz_outputs(out, case.name, case.scene, res, study or None, rate)
-    for p in paths:
+    for p in res.write(out):
         say(f"wrote {p}")
+    return 0
+
+
+def _cache(args: argparse.Namespace) -> int:
+    from fegear.mesh.cache import cache_info, clear_cache
+
+    if args.cache_command == "clear":
+        gone = clear_cache(args.kind)
+        if not gone.exists:
+            print(f"fegear cache: {gone.root} does not exist (nothing to clear)")
+            return 0
+        what = f"kind {args.kind!r}" if args.kind else "all kinds"
+        print(
+            f"fegear cache: removed {gone.files} files ({_size(gone.bytes)}) of {what} from "
+            f"{gone.root}"
+        )
+        return 0
+    info = cache_info()
+    where = "FEGEAR_CACHE" if info.source == "FEGEAR_CACHE" else "the per-user cache folder"
+    print(f"fegear cache: {info.root} ({where})")
+    if not info.exists:
+        print("  empty (the folder is made by the first run)")
+        return 0
+    if not info.is_cache:
+        print("  warning: this folder is not a fegear cache (no fegear CACHEDIR.TAG)")
+    width = max([len(k.kind) for k in info.kinds] + [5])
+    for k in info.kinds:
+        print(f"  {k.kind:<{width}}  {k.files:6d} files  {_size(k.bytes):>10}")
+    print(f"  {'total':<{width}}  {info.files:6d} files  {_size(info.bytes):>10}")
+    legacy = Path.cwd() / "meshes" / "cache"
+    if legacy.is_dir() and legacy.resolve() != info.root.resolve():
+        print(
+            f"  note: {legacy} is the cache of an older fegear, no longer used: delete it, or "
+            "reuse it with FEGEAR_CACHE"
+        )
+    return 0
+
+
+def _size(n: int) -> str:
+    for unit, k in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= k:
+            return f"{n / k:.1f} {unit}"
+    return f"{n} B"
+
+
+def _plot(args: argparse.Namespace) -> int:
+    import json
+
+    from fegear.io.flank_view import plot_flank_pattern, read_flank_vtp
+
+    folder = Path(args.folder)
+    files = sorted((folder / "vtk").glob(f"flank_{args.member}_*.vtp"))
+    if not files:
+        raise InputError(
+            "FOLDER",
+            str(folder),
+            "an output folder of `fegear run` at fidelity hybrid or fe",
+            f"no vtk/flank_{args.member}_*.vtp in it",
+        )
+    png = Path(args.png) if args.png else folder / f"bearing_pattern_{args.member}_flank.png"
+    if png.parent != Path("") and png.parent.exists() and not png.parent.is_dir():
+        raise InputError("--png", str(png), "a file in a folder")
+    frame, patches = None, []
+    for f in files:
+        frame, patch, _ = read_flank_vtp(f)
+        patches.append(patch)
+    title, p_max = folder.name, None
+    try:
+        doc = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+        title = f"{doc['case']}: {doc['fidelity']} level {doc['level']}"
+        p_max = doc["cycle"].get("p_max_MPa")
+    except (OSError, ValueError, KeyError):
+        pass
+    path = plot_flank_pattern(frame, patches, png, title, p_max)
+    if not args.quiet:
+        print(f"wrote {path} (the bearing pattern over {len(files)} positions)", file=sys.stderr)
     return 0
 
 
@@ -370,7 +486,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 2 bad input, 1 other failure)."""
     args = _parser().parse_args(argv)
     logging.basicConfig(
-        level=logging.WARNING if args.quiet else logging.WARNING,
+        level=logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
@@ -378,6 +494,10 @@ def main(argv: list[str] | None = None) -> int:
             return _run(args)
         if args.command == "sweep":
             return _sweep(args)
+        if args.command == "cache":
+            return _cache(args)
+        if args.command == "plot":
+            return _plot(args)
     except InputError as exc:
         print(f"fegear: error: {exc}", file=sys.stderr)
         return 2

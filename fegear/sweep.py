@@ -31,7 +31,8 @@ Robustness (one sweep per output folder at a time; a lock file enforces it on PO
   an interrupted run.
 - an item that fails is reported with its one-line error and does not stop the others.
 
-Dask: the workers need fegear installed and must see ``out`` and the mesh/operator cache at the
+Dask: the workers need fegear installed and must see ``out`` and the mesh/operator cache
+(:func:`fegear.mesh.cache.cache_root`: ``$FEGEAR_CACHE``, else the per-user cache folder) at the
 same paths as the client (a shared file system; a ``LocalCluster`` trivially does).
 """
 
@@ -679,9 +680,10 @@ def run_sweep(
         raise InputError("--nominal", nominal, f"one of the item names {names}")
     out = Path(out).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    cache_root = str(
-        Path(os.environ.get("FEGEAR_CACHE", Path.cwd() / "meshes" / "cache")).resolve()
-    )
+    from fegear.mesh.cache import cache_root as _cache_root
+
+    # the workers (local processes or Dask) must use this process's cache, wherever they run
+    cache_root = str(_cache_root().resolve())
     say = progress or (lambda r, k, n: None)
     t0 = time.perf_counter()
     results: dict[str, ItemResult] = {}

@@ -295,8 +295,21 @@ def test_fzg_pvd_reads_back_with_pyvista(fzg_run):
     for i, t in enumerate(reader.time_values):
         reader.set_active_time_value(t)
         blocks = reader.read()
-        assert blocks.n_blocks == 3  # pinion, gear, contact cells
+        assert blocks.n_blocks == 5  # pinion, gear, contact cells, pinion and gear flank views
         pinion, gear, cells = blocks[0], blocks[1], blocks[2]
+        for b in (pinion, gear, cells, blocks[3], blocks[4]):
+            # the time of the series is the pinion angle in degrees, in every file's field data
+            assert b.field_data["pinion_angle_deg"][0] == pytest.approx(t, abs=1e-9)
+        for flank in (blocks[3], blocks[4]):
+            assert flank.field_data["time_unit"][0] == "pinion angle phi1 (deg)"
+            loaded = flank.cell_data["outline"] == 0
+            # the flank views hold the solver's loaded cells: their forces add up to the
+            # position's force, their largest pressure is the position's (float64: round-off)
+            total_i = doc["positions"][i]["total_force_N"]
+            assert flank.cell_data["force_N"][loaded].sum() == pytest.approx(total_i, rel=1e-9)
+            assert flank.cell_data["pressure_MPa"].max() == pytest.approx(
+                doc["positions"][i]["p_max_MPa"], rel=1e-12
+            )
         for member in (pinion, gear):
             assert {"pressure_MPa", "displacement_mm", "in_contact"} <= set(member.point_data)
             u = member.point_data["displacement_mm"]

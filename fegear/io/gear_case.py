@@ -39,6 +39,7 @@ sense; a pinion torque is converted with the tooth ratio, ``T2 = T1 · N2/N1`` (
 
 from __future__ import annotations
 
+import copy
 import difflib
 import math
 from dataclasses import dataclass, field
@@ -194,6 +195,122 @@ class GearCase:
         n1, n2 = _tooth_numbers(self.kind, self.pair)
         return n2 / n1
 
+    def to_document(self) -> dict[str, Any]:
+        """The case as a case-file document (the TOML tables as dicts, units in the keys):
+        :func:`parse_gear_case` of it gives this case back (the round trip is exact)."""
+        case: dict[str, Any] = {"kind": self.kind, "name": self.name}
+        if self.description:
+            case["description"] = self.description
+        load: dict[str, Any] = {self.load_key: self.load_value}
+        if self.speed_rpm is not None:
+            load["speed_rpm"] = self.speed_rpm
+        analysis: dict[str, Any] = {
+            "fidelity": self.fidelity,
+            "level": self.level,
+            "n_positions": self.n_positions,
+            "backend": self.backend,
+        }
+        if self.n_teeth is not None:
+            analysis["n_teeth"] = self.n_teeth
+        return {
+            "case": case,
+            "pair": copy.deepcopy(self.pair),
+            "load": load,
+            "errors": {k: getattr(self.errors, k) for k in _error_keys(self.kind)},
+            "analysis": analysis,
+            "material": {"E_MPa": self.E_MPa, "nu": self.nu},
+        }
+
+    def replace(self, **changes: Any) -> GearCase:
+        """A new, validated case with some fields changed (the case itself is frozen).
+
+        Parameters
+        ----------
+        **changes
+            Fields of the case: ``name``, ``description``, ``fidelity``, ``level``,
+            ``n_positions``, ``n_teeth`` (None: automatic), ``backend``, ``E_MPa``, ``nu``,
+            ``speed_rpm`` (rpm, recorded only), ``errors`` (an
+            :class:`~fegear.assembly.InstallationErrors` or a mapping of the ``[errors]`` keys:
+            it replaces all of them, the ones not given are 0), ``pair`` (the whole ``[pair]``
+            table: ``case.replace(pair={**case.pair, "module_mm": 5.0})``), a load, which
+            replaces the case's torque (``torque2_Nm``, N·m, or ``torque2_Nmm``, N·mm, on
+            member 2; ``pinion_torque_Nm``, N·m, on member 1), and ``source``.
+
+        Returns
+        -------
+        GearCase
+            Validated exactly like a case file: the new values go into the case's document
+            (:meth:`to_document`) and through :func:`parse_gear_case`.
+
+        Raises
+        ------
+        InputError
+            An unknown or fixed field (``kind``), or a value the case file would refuse, named
+            as in the case file (``analysis.level = 7 is not allowed: must be an integer in
+            [0, 4]``).
+        """
+        doc = self.to_document()
+        source = self.source
+        for key, value in changes.items():
+            value = _plain(value)
+            if key == "source":
+                source = str(value)
+            elif key in _REPLACE_KEYS:
+                section, name = _REPLACE_KEYS[key]
+                if value is None and key in ("n_teeth", "speed_rpm", "description"):
+                    doc[section].pop(name, None)
+                else:
+                    doc[section][name] = value
+            elif key in _TORQUE_KEYS:
+                for other in _TORQUE_KEYS:
+                    doc["load"].pop(other, None)
+                doc["load"][key] = value
+            elif key == "pair":
+                if not isinstance(value, dict):
+                    raise InputError("pair", value, "a mapping of the [pair] keys")
+                doc["pair"] = value
+            elif key == "errors":
+                if isinstance(value, InstallationErrors):
+                    value = {k: getattr(value, k) for k in _error_keys(self.kind)}
+                if not isinstance(value, dict):
+                    raise InputError("errors", value, "InstallationErrors or a mapping")
+                doc["errors"] = value
+            else:
+                known = sorted([*_REPLACE_KEYS, *_TORQUE_KEYS, "pair", "errors", "source"])
+                close = difflib.get_close_matches(key, known, n=1, cutoff=0.5)
+                hint = f"did you mean {close[0]!r}?" if close else ""
+                if key in ("kind", "load_key", "load_value"):
+                    hint = "fixed for a case: load another case file for another kind"
+                    if key != "kind":
+                        hint = "give the load as torque2_Nm, torque2_Nmm or pinion_torque_Nm"
+                raise InputError(key, value, f"one of the fields {known}", hint)
+        return parse_gear_case(doc, source=source)
+
+    def with_errors(self, **errors: float) -> GearCase:
+        """A new, validated case with some installation errors changed (the others kept).
+
+        Parameters
+        ----------
+        **errors
+            ``[errors]`` keys of the case's kind: intersecting axes (face gear, spiral bevel)
+            ``dE_mm`` (shortest distance between the axes, mm), ``dA1_mm`` (ΔP: pinion axial,
+            mm), ``dA2_mm`` (ΔG, Δq: gear axial, mm), ``dgamma_deg`` (shaft angle, deg);
+            parallel axes (spur) ``da_mm`` (centre distance, mm), ``f_sigma_delta_mm``,
+            ``f_sigma_beta_mm`` (axis-parallelism errors in and out of the plane of the axes
+            over the face width, mm), ``dA1_mm``, ``dA2_mm``. Sign conventions:
+            :mod:`fegear.assembly`. ``case.replace(errors={})`` sets all of them to 0.
+
+        Raises
+        ------
+        InputError
+            A key of another kind or a misspelt one (``errors.dgamma_rad = 0.1 is not allowed:
+            must be one of the keys [...] for kind 'face_gear' (did you mean 'dgamma_deg'?)``),
+            or a value out of range, as the case file would.
+        """
+        doc = self.to_document()
+        doc["errors"].update({k: _plain(v) for k, v in errors.items()})
+        return parse_gear_case(doc, source=self.source)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready inputs (for ``summary.json``)."""
         return {
@@ -218,6 +335,37 @@ class GearCase:
             },
             "material": {"E_MPa": self.E_MPa, "nu": self.nu},
         }
+
+
+#: :meth:`GearCase.replace` field -> (case-file section, key)
+_REPLACE_KEYS = {
+    "name": ("case", "name"),
+    "description": ("case", "description"),
+    "fidelity": ("analysis", "fidelity"),
+    "level": ("analysis", "level"),
+    "n_positions": ("analysis", "n_positions"),
+    "n_teeth": ("analysis", "n_teeth"),
+    "backend": ("analysis", "backend"),
+    "E_MPa": ("material", "E_MPa"),
+    "nu": ("material", "nu"),
+    "speed_rpm": ("load", "speed_rpm"),
+}
+
+
+def _plain(value: Any) -> Any:
+    """Python values of what a case file could hold: numpy scalars and arrays become numbers
+    and lists, tuples lists (so that the case-file checks see what they expect)."""
+    import numpy as np
+
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
 
 
 def _tooth_numbers(kind: str, pair: dict[str, Any]) -> tuple[int, int]:

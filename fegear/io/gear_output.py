@@ -10,7 +10,10 @@ Files written to the output folder (each one atomically: complete or absent):
   lost, or degenerate: a loaded patch the cells do not resolve), ``cycle.p_max_MPa`` the largest
   pressure away from the flank edges, ``cycle.p_max_edge_MPa`` the edge value beside it
   (``p_max_edge_at``: position, pair, edges named), and ``null`` with a ``*_reason`` where
-  nothing physical can be reported, never 0. The engagement checks made before the analysis:
+  nothing physical can be reported, never 0. ``pattern`` (per member: the bearing pattern's
+  centre and extent on its flank, :class:`fegear.io.flank_view.PatternCentre`) and ``cache``
+  (the cache folder, the artefacts read from it and those built). The engagement checks made
+  before the analysis:
   ``cycle.tip_clearance_mm``, ``cycle.unloaded_interior_contact_fraction`` (the contact ratio
   when below 1), ``cycle.positions_without_unloaded_contact``; one pair's unloaded contact over
   its whole contact interval (:func:`fegear.tca.path.contact_path`):
@@ -37,8 +40,17 @@ Files written to the output folder (each one atomically: complete or absent):
   ``Σ pressure·area = Σ force``), ``gap_mm``, ``active``, ``edge``, ``pair``,
   ``pinion_tooth``, ``gear_tooth``: the exact solver output. A position without contact has an
   empty file (VTK/ParaView/pyvista read it; meshio 5.3 cannot read an empty VTU).
-- ``cycle.pvd`` — the collection: time = pinion angle (deg), parts 0 pinion, 1 gear, 2 contact
-  cells; open it in ParaView and press play.
+- ``vtk/flank_pinion_<i>.vtp``, ``vtk/flank_gear_<i>.vtp`` (fidelities ``fe`` and ``hybrid``)
+  — the flank views (:mod:`fegear.io.flank_view`): the loaded contact cells of each member on
+  its own working flank in flank coordinates, ``x`` the face coordinate and ``y`` the profile
+  coordinate (mm; for the face gear the radius and the height above the pitch plane), cell data
+  ``pressure_MPa``, ``force_N``, ``tooth``, ``pair``, ``edge``, with the working-surface
+  outline (a line, ``outline`` = 1). All teeth share the flank; the bearing pattern of one
+  position is what the flank shows, the cycle plays the patch across it.
+- ``cycle.pvd`` — the collection: **time = pinion angle φ1 in degrees** (said in a comment of
+  the file and in the field data ``pinion_angle_deg`` of every file of the series, the
+  ``.vtp`` also in ``time_unit``); parts 0 pinion, 1 gear, 2 contact cells, 3 pinion flank view,
+  4 gear flank view; open it in ParaView and press play.
 - PNGs: ``te.png`` (unloaded and loaded TE), ``load_share.png``, ``p_max.png``,
   ``bearing_pattern.png`` (union of the loaded cells on the pinion flank, coloured by the largest
   pressure seen over the cycle). Fidelity ``tca``: ``te.png`` and ``bearing_pattern.png``
@@ -48,6 +60,7 @@ Files written to the output folder (each one atomically: complete or absent):
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
@@ -56,10 +69,48 @@ import numpy as np
 
 from fegear.geometry.transforms import apply_points, apply_vectors
 from fegear.io.files import atomic_write, write_json
+from fegear.io.flank_view import (
+    TIME_UNIT,
+    FlankFrame,
+    FlankPatch,
+    PatternCentre,
+    flank_frames,
+    flank_patches,
+    pattern_centre,
+    write_flank_vtp,
+)
 from fegear.io.gear_run import GearRun, report
 from fegear.io.records import solver_record, versions
 
-__all__ = ["write_gear_outputs", "gear_summary", "write_pvd"]
+__all__ = ["FlankViews", "flank_views", "write_gear_outputs", "gear_summary", "write_pvd"]
+
+
+@dataclass(frozen=True)
+class FlankViews:
+    """The flank views of a run (:mod:`fegear.io.flank_view`), computed once for the files,
+    the summary and the pictures.
+
+    Attributes
+    ----------
+    frames
+        ``{member: FlankFrame}``.
+    patches
+        Per position ``{member: FlankPatch}`` (empty for the fidelities without contact cells).
+    pattern
+        ``{member: PatternCentre}``.
+    """
+
+    frames: dict[str, FlankFrame]
+    patches: tuple[dict[str, FlankPatch], ...]
+    pattern: dict[str, PatternCentre]
+
+
+def flank_views(run: GearRun) -> FlankViews:
+    """The :class:`FlankViews` of a run."""
+    frames = flank_frames(run)
+    patches = tuple(flank_patches(run, frames=frames)) if run.cycle is not None else ()
+    return FlankViews(frames, patches, pattern_centre(run, frames, list(patches)))
+
 
 ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 
@@ -203,8 +254,11 @@ def _tca_positions(run: GearRun) -> list[dict[str, Any]]:
     return rows
 
 
-def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]:
-    """The ``summary.json`` document of a gear run."""
+def gear_summary(
+    run: GearRun, files: list[str] | None = None, views: FlankViews | None = None
+) -> dict[str, Any]:
+    """The ``summary.json`` document of a gear run (``views``: its flank views, which give
+    ``pattern``; without them ``pattern`` is null — :func:`write_gear_outputs` passes them)."""
     case = run.case
     doc: dict[str, Any] = {
         "case": case.name,
@@ -318,6 +372,10 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
         doc["positions"] = _tca_positions(run)
         doc["timings_s"] = dict(run.seconds)
         warnings = list(rep.warnings)
+    doc["pattern"] = (
+        {m: pc.as_dict() for m, pc in views.pattern.items()} if views is not None else None
+    )
+    doc["cache"] = run.cache.as_dict() if run.cache is not None else None
     doc["warnings"] = warnings
     doc["files"] = files or []
     doc["versions"] = versions()
@@ -329,10 +387,29 @@ def gear_summary(run: GearRun, files: list[str] | None = None) -> dict[str, Any]
 # --------------------------------------------------------------------------------------------
 
 
-def _write_vtu(path: Path, mesh) -> Path:
+def _write_vtu(path: Path, mesh, time_deg: float | None = None) -> Path:
+    """meshio's VTU, with the field data ``pinion_angle_deg`` (the time of the series) when
+    ``time_deg`` is given (meshio writes no field data: the block goes in before the piece;
+    numbers only, which meshio reads back)."""
     import meshio
 
-    return atomic_write(path, lambda q: meshio.write(q, mesh, file_format="vtu"))
+    def write(q: Path) -> None:
+        meshio.write(q, mesh, file_format="vtu")
+        if time_deg is None:
+            return
+        text = q.read_text(encoding="utf-8")
+        block = (
+            "<FieldData>\n"
+            '<DataArray type="Float64" Name="pinion_angle_deg" NumberOfTuples="1" '
+            f'format="ascii">\n{time_deg!r}\n</DataArray>\n'
+            "</FieldData>\n"
+        )
+        head = "<UnstructuredGrid>\n"
+        if head not in text:  # pragma: no cover  (meshio's layout)
+            raise RuntimeError("unexpected VTU layout from meshio: no <UnstructuredGrid>")
+        q.write_text(text.replace(head, head + block, 1), encoding="utf-8")
+
+    return atomic_write(path, write)
 
 
 def _cell_quads(cells) -> np.ndarray:
@@ -413,10 +490,12 @@ def _member_mesh(mf, i: int, pos):
     )
 
 
-def write_pvd(path: Path, entries: list[tuple[float, int, str]]) -> Path:
-    """A ParaView collection: ``entries`` of ``(time, part, relative file)``."""
+def write_pvd(path: Path, entries: list[tuple[float, int, str]], parts: str = "") -> Path:
+    """A ParaView collection: ``entries`` of ``(time, part, relative file)``; the time is the
+    pinion angle in degrees (said in a comment, with ``parts``, the names of the parts)."""
     lines = [
         '<?xml version="1.0"?>',
+        f"<!-- fegear: timestep = {TIME_UNIT}" + (f"; {parts}" if parts else "") + " -->",
         '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
         "  <Collection>",
     ]
@@ -429,19 +508,30 @@ def write_pvd(path: Path, entries: list[tuple[float, int, str]]) -> Path:
     return atomic_write(path, lambda q: q.write_text(text, encoding="utf-8"))
 
 
-def _write_vtk(out: Path, run: GearRun) -> list[Path]:
+def _write_vtk(out: Path, run: GearRun, views: FlankViews) -> list[Path]:
     vtk = out / "vtk"
     paths, entries = [], []
+    names = [mf.name for mf in run.members] + ["contact cells"]
+    flanks = bool(views.patches) and bool(run.members)  # the fidelities with contact cells
+    if flanks:
+        names += [f"{m} flank view" for m in views.frames]
     for i, pos in enumerate(run.cycle.positions):
         t = math.degrees(pos.phi1)
         for part, mf in enumerate(run.members):
             name = f"{mf.name}_{i:03d}.vtu"
-            paths.append(_write_vtu(vtk / name, _member_mesh(mf, i, pos)))
+            paths.append(_write_vtu(vtk / name, _member_mesh(mf, i, pos), t))
             entries.append((t, part, f"vtk/{name}"))
         name = f"contact_cells_{i:03d}.vtu"
-        paths.append(_write_vtu(vtk / name, _contact_mesh(pos)))
+        empty = not pos.cells  # meshio cannot read an empty VTU back: no field data there
+        paths.append(_write_vtu(vtk / name, _contact_mesh(pos), None if empty else t))
         entries.append((t, len(run.members), f"vtk/{name}"))
-    paths.append(write_pvd(out / "cycle.pvd", entries))
+        if flanks:
+            for k, (member, frame) in enumerate(views.frames.items()):
+                name = f"flank_{member}_{i:03d}.vtp"
+                paths.append(write_flank_vtp(vtk / name, frame, views.patches[i][member], t))
+                entries.append((t, len(run.members) + 1 + k, f"vtk/{name}"))
+    parts = "parts: " + ", ".join(f"{k} {n}" for k, n in enumerate(names))
+    paths.append(write_pvd(out / "cycle.pvd", entries, parts))
     return paths
 
 
@@ -678,18 +768,22 @@ def _tca_plots(out: Path, run: GearRun) -> list[Path]:
     return paths
 
 
-def write_gear_outputs(out: Path, run: GearRun) -> list[Path]:
-    """Write every output of a gear run into ``out`` (atomically); returns the paths."""
+def write_gear_outputs(out: Path, run: GearRun, views: FlankViews | None = None) -> list[Path]:
+    """Write every output of a gear run into ``out`` (atomically); returns the paths.
+
+    ``views``: the run's flank views (:func:`flank_views`), computed if not given.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    views = views if views is not None else flank_views(run)
     paths: list[Path] = []
     if run.cycle is not None:
-        paths += _write_vtk(out, run)
+        paths += _write_vtk(out, run, views)
         paths += [_plot_te(out, run), _plot_load_share(out, run), _plot_p_max(out, run),
                   _plot_pattern(out, run)]  # fmt: skip
     else:
         paths += _tca_plots(out, run)
     files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]
     # the summary last: its presence says the run is complete
-    paths.append(write_json(out / "summary.json", gear_summary(run, files)))
+    paths.append(write_json(out / "summary.json", gear_summary(run, files, views)))
     return paths

@@ -287,6 +287,9 @@ class GearRun:
         Wall time per stage.
     engagement
         What :func:`check_engagement` found before the analysis.
+    cache
+        The artefact-cache lookups of the run (:class:`fegear.mesh.cache.CacheUse`: what was
+        read, what was built), or None.
     """
 
     case: GearCase
@@ -297,6 +300,7 @@ class GearRun:
     members: tuple[MemberField, ...] = ()
     seconds: dict[str, float] = field(default_factory=dict)
     engagement: Engagement | None = None
+    cache: Any = None
 
     @property
     def fidelity(self) -> str:
@@ -447,6 +451,16 @@ def run_gear_case(
         contact at any position (naming the installation errors), or a tip running into the
         mate's root (naming the error and the depth). Both are decided before any FE work.
     """
+    from dataclasses import replace
+
+    from fegear.mesh.cache import record_cache_use
+
+    with record_cache_use() as used:
+        run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify)
+    return replace(run, cache=used())
+
+
+def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> GearRun:
     from fegear.ltca import LTCAOptions, build_models, run_ltca
     from fegear.ltca.cycle import cycle_tca
     from fegear.tca import TCAOptions

@@ -1,0 +1,596 @@
+"""Flank views: the loaded contact cells of each member in its own flank coordinates.
+
+What a gear engineer reads is the pressure on the flank (the bearing pattern), not a sliver on a
+3D sector. For each mesh position and member, the loaded contact cells (pressure > 0) are mapped
+onto the member's working flank and drawn in **flank coordinates**: ``face`` across (the face
+coordinate ``v`` of :class:`~fegear.geometry.surface.FlankBoundaries`: the radius ``L`` of a face
+gear, the cone distance of a bevel toe → heel, the axial position ``z`` of a cylindrical gear, mm)
+and ``profile`` up (:meth:`FlankBoundaries.profile`: the height above the pitch plane / cone where
+the family defines it, else the profile coordinate ``u``, mm). All teeth share the one flank (the
+teeth are identical): a cell carries the tooth it lies on.
+
+The cells are the solver's (:class:`fegear.ltca.grid.PairCells`, on the pinion flank): a pinion
+cell corner is the point of the exact pinion flank under it (the Newton line hit of
+:func:`fegear.tca.solve.line_hit` along the pinion normal); the gear cell is the pinion cell
+carried along the pinion normal by the cell's gap onto the exact gear flank, at the gear's
+TCA-closed angle (the placement of the sectors in the VTK files), its flank coordinates found the
+same way.
+
+Writers and readers:
+
+- :func:`write_flank_vtp` — ``vtk/flank_<member>_<i>.vtp``: the loaded cells as quads in the plane
+  ``(face, profile, 0)`` with cell data ``pressure_MPa``, ``force_N``, ``tooth``, ``pair``,
+  ``edge``, and the working-surface outline as a line (cell data 0 / −1 there; ``outline`` 1);
+  field data ``pinion_angle_deg`` (the time of the ``.pvd`` series) and ``time_unit``.
+- :func:`plot_flank_pattern` — the bearing pattern over the cycle on one member's flank (the
+  envelope of all loaded patches: the largest pressure each point of the flank saw) with the
+  working-surface outline (as :func:`fegear.tca.plots.flank_outline` draws it), as a PNG.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fegear.io.files import atomic_write
+
+__all__ = [
+    "FlankFrame",
+    "FlankPatch",
+    "PatternCentre",
+    "TIME_UNIT",
+    "flank_frames",
+    "flank_patches",
+    "pattern_centre",
+    "plot_flank_pattern",
+    "read_flank_vtp",
+    "write_flank_vtp",
+]
+
+log = logging.getLogger(__name__)
+
+Array = NDArray[np.float64]
+
+#: What the time of the ``.pvd`` series is (also in every file's field data).
+TIME_UNIT = "pinion angle phi1 (deg)"
+MEMBERS = ("pinion", "gear")
+
+
+@dataclass(frozen=True)
+class FlankFrame:
+    """One member's working flank in flank coordinates.
+
+    Attributes
+    ----------
+    member
+        ``"pinion"`` or ``"gear"``.
+    face_name, profile_name
+        What the two coordinates are, with units.
+    outline
+        ``(k, 2)`` mm, the working surface's boundary as a closed polyline ``(face, profile)``:
+        the fillet limit and the tip as curves over the face (first point repeated last).
+    face_ends
+        Names of the face ends at ``v_start`` and ``v_end`` (``"inner end"``/``"outer end"``,
+        ``"toe"``/``"heel"``, ``"-z"``/``"+z"``).
+    bounds
+        The :class:`~fegear.geometry.surface.FlankBoundaries`.
+    """
+
+    member: str
+    face_name: str
+    profile_name: str
+    outline: Array
+    face_ends: tuple[str, str] = ("", "")
+    bounds: Any = field(default=None, repr=False, compare=False)
+
+    def coordinates(self, u: Array, v: Array) -> Array:
+        """``(..., 2)`` ``(face, profile)`` mm of flank coordinates ``(u, v)``."""
+        return np.stack(np.broadcast_arrays(v, self.bounds.profile(u, v)), -1)
+
+
+@dataclass(frozen=True)
+class FlankPatch:
+    """The loaded contact cells of one member at one position, in its flank coordinates.
+
+    Attributes
+    ----------
+    member
+        ``"pinion"`` or ``"gear"``.
+    quads
+        ``(m, 4, 2)`` mm, cell corners ``(face, profile)``.
+    centres
+        ``(m, 2)`` mm, cell centres ``(face, profile)``.
+    pressure_MPa, force_N
+        ``(m,)`` the cells' pressure and force (the solver's).
+    tooth
+        ``(m,)`` the member's tooth the cell lies on.
+    pair
+        ``(m,)`` index of the pair at the position (``positions[i].pairs[pair]`` of
+        ``summary.json``).
+    edge
+        ``(m,)`` the cell touches a boundary of a working flank.
+    """
+
+    member: str
+    quads: Array
+    centres: Array
+    pressure_MPa: Array
+    force_N: Array
+    tooth: NDArray[np.int_]
+    pair: NDArray[np.int_]
+    edge: NDArray[np.bool_]
+
+    @staticmethod
+    def empty(member: str) -> FlankPatch:
+        z = np.zeros(0)
+        i = np.zeros(0, dtype=np.int64)
+        return FlankPatch(member, np.zeros((0, 4, 2)), np.zeros((0, 2)), z, z, i, i,
+                          np.zeros(0, dtype=bool))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PatternCentre:
+    """Where the bearing pattern is on one member's flank over the cycle.
+
+    Attributes
+    ----------
+    member
+        ``"pinion"`` or ``"gear"``.
+    face_mm, profile_mm
+        Centre ``(face, profile)`` (mm; :class:`FlankFrame`): the force-weighted centroid of the
+        loaded cells over all positions (loaded fidelities), or the mean of the unloaded contact
+        points over the positions with contact, of every pair within the paint thickness
+        (6.32 µm: where two pairs close together, both) (fidelity ``tca``). None with
+        ``reason`` when there is none.
+    face_range_mm, profile_range_mm
+        ``(min, max)`` of the loaded cells (or of the path): the extent of the pattern.
+    face_name, profile_name
+        What the coordinates are.
+    weighting
+        ``"cell force"`` or ``"unloaded contact path"``.
+    reason
+        Why there is no centre ("" when there is).
+    """
+
+    member: str
+    face_mm: float | None
+    profile_mm: float | None
+    face_range_mm: tuple[float, float] | None
+    profile_range_mm: tuple[float, float] | None
+    face_name: str
+    profile_name: str
+    weighting: str
+    reason: str = ""
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready (``summary.json``: ``pattern``)."""
+        return {
+            "face_mm": self.face_mm,
+            "profile_mm": self.profile_mm,
+            "face_range_mm": None if self.face_range_mm is None else list(self.face_range_mm),
+            "profile_range_mm": (
+                None if self.profile_range_mm is None else list(self.profile_range_mm)
+            ),
+            "face": self.face_name,
+            "profile": self.profile_name,
+            "weighting": self.weighting,
+            "reason": self.reason,
+        }
+
+
+# --------------------------------------------------------------------------------------------
+# Flank coordinates
+# --------------------------------------------------------------------------------------------
+
+
+def _face_ends(bounds) -> tuple[str, str]:
+    v = (getattr(bounds, "v_name", "") or "").lower()
+    if "toe" in v:
+        return "toe", "heel"
+    if v.startswith("radius"):
+        return "inner end", "outer end"
+    return "-z", "+z"
+
+
+def _maps(run):
+    """The exact flank maps of both members (the TCA's)."""
+    from fegear.tca.surfaces import flank_map
+
+    asm = run.assembly
+    return {
+        "pinion": flank_map(run.pair.pinion, asm.side1),
+        "gear": flank_map(run.pair.gear, asm.side2),
+    }
+
+
+def flank_frames(run, maps=None) -> dict[str, FlankFrame]:
+    """The working flank of each member of a :class:`~fegear.io.gear_run.GearRun`."""
+    maps = maps or _maps(run)
+    out = {}
+    for member, fm in maps.items():
+        b = fm.bounds
+        v = np.linspace(b.v_start, b.v_end, 121)
+        lo, hi = b.fillet_curve(v), b.tip_curve(v)  # as fegear.tca.plots.flank_outline
+        outline = np.stack([np.r_[v, v[::-1], v[:1]], np.r_[lo, hi[::-1], lo[:1]]], -1)
+        out[member] = FlankFrame(
+            member=member,
+            face_name=b.v_name,
+            profile_name=b.height_name or b.u_name,
+            outline=outline,
+            face_ends=_face_ends(b),
+            bounds=b,
+        )
+    return out
+
+
+def _cell_corners(cells) -> Array:
+    """``(n, 4, 3)`` corners of the cells from their 2 × 2 Gauss points (bilinear extrapolation
+    from ``±1/√3`` to ``±1``), counter-clockwise in the cell axes."""
+    q = cells.quad_points.reshape(-1, 2, 2, 3)
+    c = q.mean(axis=(1, 2))
+    order = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    return np.stack([c + math.sqrt(3.0) * (q[:, a, b] - c) for a, b in order], axis=1)
+
+
+class _Projector:
+    """Flank coordinates ``(u, v)`` of points on (or within a cell of) a member's flank: the
+    Newton line hit of the line through the point along a given direction with the exact flank
+    (tooth ``t`` of the member placed by ``M``)."""
+
+    def __init__(self, fm, n: int = 41) -> None:
+        from scipy.spatial import cKDTree
+
+        b = fm.bounds
+        U, V = np.meshgrid(np.linspace(b.u_fillet, b.u_tip, n), np.linspace(b.v_start, b.v_end, n),
+                           indexing="ij")  # fmt: skip
+        self.fm = fm
+        self.a, self.b = (x.ravel() for x in fm.native(U.ravel(), V.ravel()))
+        self.tree = cKDTree(fm.evaluate(self.a, self.b)[0])
+
+    def start(self, P: Array) -> tuple[Array, Array]:
+        i = self.tree.query(P)[1]
+        return self.a[i], self.b[i]
+
+    def __call__(self, P: Array, N: Array, a0: Array, b0: Array):
+        from fegear.tca.solve import line_hit
+
+        a, b, _, p, _, ok = line_hit(self.fm, a0, b0, P, N)
+        u, v = self.fm.flank(a, b, p)
+        return np.asarray(u, float), np.asarray(v, float), a, b, ok
+
+
+def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
+    """The loaded cells of both members at every position of a loaded
+    :class:`~fegear.io.gear_run.GearRun`, in flank coordinates (empty for the ``hertz``
+    fidelity, which has no contact cells, and at positions without load)."""
+    from fegear.assembly import tooth_transform
+    from fegear.geometry.transforms import apply_points, apply_vectors, compose, inverse
+
+    cyc = run.cycle
+    out: list[dict[str, FlankPatch]] = []
+    if cyc is None:
+        return out
+    maps = maps or _maps(run)
+    frames = frames or flank_frames(run, maps)
+    asm = run.assembly
+    proj: dict[str, _Projector] = {}
+    failed = 0
+    for i, pos in enumerate(cyc.positions):
+        here = {m: FlankPatch.empty(m) for m in MEMBERS}
+        rows: dict[str, list] = {m: [] for m in MEMBERS}
+        offset = 0
+        for ip, (c, p) in enumerate(zip(pos.cells, pos.pressure, strict=True)):
+            sl = slice(offset, offset + c.n)
+            offset += c.n
+            load = np.flatnonzero(p > 0)
+            if load.size == 0:
+                continue
+            force = pos.solution.force[sl][load]
+            corners = _cell_corners(c)[load]
+            normals = c.normals[load]
+            for member in MEMBERS:
+                fm = maps[member]
+                if member not in proj:
+                    proj[member] = _Projector(fm)
+                pj = proj[member]
+                if member == "pinion":
+                    M = compose(asm.placement1(pos.phi1), tooth_transform(asm.n1, c.k))
+                    X0 = c.centers[load]
+                    Xc = corners
+                    u0, v0 = c.uv[load, 0], c.uv[load, 1]
+                    a0, b0 = fm.native(u0, v0)
+                else:
+                    M = compose(asm.placement2(run.phi2[i]), tooth_transform(asm.n2, c.j))
+                    gap = c.gap[load]
+                    X0 = c.centers[load] + gap[:, None] * normals
+                    Xc = corners + gap[:, None, None] * normals[:, None, :]
+                Mi = inverse(M)
+                Nm = apply_vectors(Mi, normals)
+                if member == "gear":
+                    P0 = apply_points(Mi, X0)
+                    u0, v0, a0, b0, ok0 = pj(P0, Nm, *pj.start(P0))
+                    failed += int(np.count_nonzero(~ok0))
+                Pc = apply_points(Mi, Xc)
+                Nc = np.broadcast_to(Nm[:, None, :], Pc.shape)
+                A0 = np.broadcast_to(np.asarray(a0)[:, None], Pc.shape[:2])
+                B0 = np.broadcast_to(np.asarray(b0)[:, None], Pc.shape[:2])
+                uc, vc, _, _, okc = pj(Pc, Nc, A0, B0)
+                bad = ~okc
+                if bad.any():  # a corner the Newton did not reach: the cell shrinks to its centre
+                    failed += int(np.count_nonzero(bad))
+                    uc = np.where(bad, np.asarray(u0)[:, None], uc)
+                    vc = np.where(bad, np.asarray(v0)[:, None], vc)
+                fr = frames[member]
+                rows[member].append(
+                    (
+                        fr.coordinates(uc, vc),
+                        fr.coordinates(np.asarray(u0), np.asarray(v0)),
+                        p[load],
+                        force,
+                        np.full(load.size, c.k if member == "pinion" else c.j, np.int64),
+                        np.full(load.size, ip, np.int64),
+                        c.boundary[load],
+                    )
+                )
+        for member in MEMBERS:
+            if rows[member]:
+                cols = [np.concatenate(x) for x in zip(*rows[member], strict=True)]
+                here[member] = FlankPatch(member, *cols)
+        out.append(here)
+    if failed:
+        log.warning("flank views: %d cell points not found on the exact flank (drawn at the "
+                    "cell centre)", failed)  # fmt: skip
+    return out
+
+
+def pattern_centre(run, frames=None, patches=None) -> dict[str, PatternCentre]:
+    """:class:`PatternCentre` of both members of a run (loaded: force-weighted centroid of the
+    loaded cells; ``tca``: mean of the unloaded contact points of the pairs within the paint
+    thickness over the positions with contact; ``hertz``: none, it has no contact cells)."""
+    frames = frames or flank_frames(run)
+    out = {}
+    _none = {"face_mm": None, "profile_mm": None, "face_range_mm": None, "profile_range_mm": None}
+    for member in MEMBERS:
+        fr = frames[member]
+        kw = {"member": member, "face_name": fr.face_name, "profile_name": fr.profile_name}
+        if run.cycle is None:
+            r = run.tca
+            # every pair within the paint thickness, not only "the" pair in contact: where two
+            # pairs close together (a conjugate TE) the choice between them is round-off
+            uv = [
+                (p.pinion_uv if member == "pinion" else p.gear_uv)[k]
+                for p in r.positions
+                if p.has_contact
+                for k in np.flatnonzero(p.pair_valid & (p.backlash_mm <= r.paint_mm))
+            ]
+            uv = np.reshape(uv, (-1, 2))
+            if uv.shape[0] == 0:
+                out[member] = PatternCentre(**_none, weighting="unloaded contact path",
+                                            reason="no position has contact", **kw)  # fmt: skip
+                continue
+            xy = fr.coordinates(uv[:, 0], uv[:, 1])
+            w = np.ones(xy.shape[0])
+            weighting = "unloaded contact path"
+        else:
+            patches = patches if patches is not None else flank_patches(run, frames=frames)
+            got = [p[member] for p in patches if p[member].force_N.size]
+            if not got:
+                why = (
+                    "the hertz fidelity has no contact cells"
+                    if run.fidelity == "hertz"
+                    else "no loaded cell at any position"
+                )
+                out[member] = PatternCentre(**_none, weighting="cell force", reason=why, **kw)
+                continue
+            xy = np.concatenate([g.centres for g in got])
+            w = np.concatenate([g.force_N for g in got])
+            weighting = "cell force"
+        c = (w @ xy) / w.sum()
+        out[member] = PatternCentre(
+            face_mm=float(c[0]),
+            profile_mm=float(c[1]),
+            face_range_mm=(float(xy[:, 0].min()), float(xy[:, 0].max())),
+            profile_range_mm=(float(xy[:, 1].min()), float(xy[:, 1].max())),
+            weighting=weighting,
+            **kw,
+        )
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# VTP
+# --------------------------------------------------------------------------------------------
+
+
+def write_flank_vtp(path: Path, frame: FlankFrame, patch: FlankPatch, time_deg: float) -> Path:
+    """One member's flank at one position as a ``.vtp`` (module docstring), atomically."""
+    import pyvista as pv
+
+    m = patch.quads.shape[0]
+    k = frame.outline.shape[0]
+    pts = np.zeros((k + 4 * m, 3))
+    pts[:k, :2] = frame.outline
+    pts[k:, :2] = patch.quads.reshape(-1, 2)
+    lines = np.r_[k, np.arange(k)]
+    faces = np.c_[np.full(m, 4), k + np.arange(4 * m).reshape(m, 4)].ravel()
+    mesh = pv.PolyData(pts, faces=faces if m else None, lines=lines)
+    # VTK orders the cells verts, lines, polys: the outline first, then the cells
+    mesh.cell_data["pressure_MPa"] = np.r_[0.0, patch.pressure_MPa]
+    mesh.cell_data["force_N"] = np.r_[0.0, patch.force_N]
+    mesh.cell_data["tooth"] = np.r_[-1, patch.tooth].astype(np.int32)
+    mesh.cell_data["pair"] = np.r_[-1, patch.pair].astype(np.int32)
+    mesh.cell_data["edge"] = np.r_[0, patch.edge.astype(np.int32)].astype(np.int32)
+    mesh.cell_data["outline"] = np.r_[1, np.zeros(m, np.int32)].astype(np.int32)
+    mesh.field_data["pinion_angle_deg"] = np.array([time_deg])
+    mesh.field_data["time_unit"] = [TIME_UNIT]
+    mesh.field_data["member"] = [frame.member]
+    mesh.field_data["x_axis"] = [f"face: {frame.face_name}"]
+    mesh.field_data["y_axis"] = [f"profile: {frame.profile_name}"]
+    mesh.field_data["face_ends"] = list(frame.face_ends)
+    return atomic_write(path, lambda q: mesh.save(str(q), binary=True))
+
+
+def read_flank_vtp(path: Path) -> tuple[FlankFrame, FlankPatch, float]:
+    """Read back :func:`write_flank_vtp`: ``(frame, patch, pinion angle deg)`` (the frame
+    without its ``bounds``)."""
+    import pyvista as pv
+
+    mesh = pv.read(str(path))
+    fd = mesh.field_data
+    member = str(fd["member"][0])
+    line = mesh.lines
+    k = int(line[0])
+    outline = np.asarray(mesh.points[line[1 : 1 + k], :2])
+    faces = np.asarray(mesh.faces).reshape(-1, 5)[:, 1:] if np.asarray(mesh.faces).size else None
+    cd = mesh.cell_data
+    sel = np.asarray(cd["outline"]) == 0
+    if faces is None or faces.size == 0:
+        patch = FlankPatch.empty(member)
+    else:
+        quads = np.asarray(mesh.points)[faces][:, :, :2]
+        patch = FlankPatch(
+            member,
+            quads,
+            quads.mean(axis=1),
+            np.asarray(cd["pressure_MPa"])[sel],
+            np.asarray(cd["force_N"])[sel],
+            np.asarray(cd["tooth"])[sel].astype(np.int64),
+            np.asarray(cd["pair"])[sel].astype(np.int64),
+            np.asarray(cd["edge"])[sel] != 0,
+        )
+    ends = tuple(str(x) for x in fd["face_ends"]) if "face_ends" in fd else ("", "")
+    frame = FlankFrame(
+        member,
+        str(fd["x_axis"][0]).removeprefix("face: "),
+        str(fd["y_axis"][0]).removeprefix("profile: "),
+        outline,
+        (ends + ("", ""))[:2],
+    )
+    return frame, patch, float(fd["pinion_angle_deg"][0])
+
+
+# --------------------------------------------------------------------------------------------
+# The bearing pattern over the cycle
+# --------------------------------------------------------------------------------------------
+
+
+def _envelope(frame: FlankFrame, patches: Sequence[FlankPatch], shape=(360, 900)):
+    """Pixels ``(ny, nx)`` over the outline's box: the largest pressure each saw (0: none)."""
+    box_lo, box_hi = frame.outline.min(axis=0), frame.outline.max(axis=0)
+    span = np.maximum(box_hi - box_lo, 1e-9)
+    ny, nx = shape
+    px = span / np.array([nx, ny])
+    img = np.zeros((ny, nx))
+    for p in patches:
+        if p.pressure_MPa.size == 0:
+            continue
+        q = (p.quads - box_lo) / px  # corners in pixels
+        # samples along each cell edge: at most half a pixel apart (no holes between cells)
+        n1 = np.clip(np.ceil(2 * np.linalg.norm(q[:, 1] - q[:, 0], axis=1)), 1, 256).astype(int)
+        n2 = np.clip(np.ceil(2 * np.linalg.norm(q[:, 3] - q[:, 0], axis=1)), 1, 256).astype(int)
+        for s1, s2 in set(zip(n1.tolist(), n2.tolist(), strict=True)):
+            sel = np.flatnonzero((n1 == s1) & (n2 == s2))
+            S, T = np.meshgrid((np.arange(s1) + 0.5) / s1, (np.arange(s2) + 0.5) / s2,
+                               indexing="ij")  # fmt: skip
+            S, T = S.ravel(), T.ravel()
+            c = q[sel]  # bilinear over the quad's corners 0-1-2-3
+            pts = (
+                ((1 - S) * (1 - T))[None, :, None] * c[:, None, 0]
+                + (S * (1 - T))[None, :, None] * c[:, None, 1]
+                + (S * T)[None, :, None] * c[:, None, 2]
+                + ((1 - S) * T)[None, :, None] * c[:, None, 3]
+            )
+            ix = np.clip(pts[..., 0].astype(int), 0, nx - 1).ravel()
+            iy = np.clip(pts[..., 1].astype(int), 0, ny - 1).ravel()
+            val = np.repeat(p.pressure_MPa[sel], S.size)
+            np.maximum.at(img, (iy, ix), val)
+    return img, box_lo, box_hi
+
+
+def plot_flank_pattern(
+    frame: FlankFrame,
+    patches: Sequence[FlankPatch],
+    path: Path,
+    title: str = "",
+    p_max_MPa: float | None = None,
+) -> Path:
+    """The bearing pattern over the cycle on one member's flank as a PNG.
+
+    Parameters
+    ----------
+    frame
+        The member's flank (its outline).
+    patches
+        The member's :class:`FlankPatch` at every position.
+    path
+        The PNG to write (atomically).
+    title
+        First line of the title.
+    p_max_MPa
+        Top of the colour scale (the cycle's p_max away from the edges: singular edge peaks are
+        shown at the top colour); None: the largest pressure.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    img, lo, hi = _envelope(frame, patches)
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    top = float(img.max())
+    vmax = p_max_MPa if p_max_MPa and p_max_MPa > 0 else (top or None)
+    clipped = vmax is not None and top > vmax * (1 + 1e-9)
+    if top > 0:
+        im = ax.imshow(
+            np.ma.masked_where(img <= 0, img),
+            origin="lower",
+            extent=(lo[0], hi[0], lo[1], hi[1]),
+            aspect="auto",
+            cmap="inferno",
+            vmin=0,
+            vmax=vmax,
+            interpolation="nearest",
+        )
+        label = "largest pressure over the cycle (MPa)"
+        if clipped:
+            label += f"\n(edge contacts up to {top:.0f} MPa at the top colour)"
+        fig.colorbar(im, ax=ax, label=label, extend="max" if clipped else "neither")
+    force = [(p.force_N, p.centres) for p in patches if p.force_N.size]
+    if force:
+        w = np.concatenate([f for f, _ in force])
+        xy = np.concatenate([c for _, c in force])
+        cx, cy = (w @ xy) / w.sum()
+        ax.plot([cx], [cy], "c+", ms=14, mew=2, label="pattern centre (force-weighted)")
+        ax.legend(fontsize=8, loc="upper right")
+    o = frame.outline
+    ax.plot(o[:, 0], o[:, 1], "k-", lw=1)
+    a, b = frame.face_ends
+    ytop = o[:, 1].max()
+    if a:
+        ax.annotate(a, (o[0, 0], ytop), textcoords="offset points", xytext=(2, 4), fontsize=8)
+    if b:
+        ax.annotate(b, (o[:, 0].max(), ytop), textcoords="offset points", xytext=(-40, 4),
+                    fontsize=8)  # fmt: skip
+    pad = 0.04 * (hi - lo)
+    ax.set_xlim(lo[0] - pad[0], hi[0] + pad[0])
+    ax.set_ylim(lo[1] - pad[1], hi[1] + 3 * pad[1])
+    ax.set_xlabel(frame.face_name)
+    ax.set_ylabel(frame.profile_name)
+    n = sum(bool(p.force_N.size) for p in patches)
+    ax.set_title(
+        (title + "\n" if title else "")
+        + f"bearing pattern on the {frame.member} flank ({n} of {len(patches)} positions loaded)",
+        fontsize=9,
+    )
+    ax.grid(alpha=0.2)
+    fig.tight_layout()
+    out = atomic_write(Path(path), lambda q: fig.savefig(q, format="png", dpi=110))
+    plt.close(fig)
+    return out
