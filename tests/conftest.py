@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
+from pathlib import Path
 
 # Dense BLAS/LAPACK (OpenBLAS under numpy) on one thread: the contact grids of the tests are small
 # (a few hundred cells), so threads buy nothing, and a fixed thread count keeps the floating-point
@@ -17,15 +20,28 @@ os.environ.setdefault("FEGEAR_WORKERS", "1")
 import pytest  # noqa: E402
 
 
-@pytest.fixture(scope="session", autouse=True)
-def fegear_cache(tmp_path_factory: pytest.TempPathFactory):
-    """Point ``$FEGEAR_CACHE`` at a fresh folder: tests start cold and never touch the repo's
-    ``meshes/cache``. Restored at the end of the session."""
-    root = tmp_path_factory.mktemp("fegear_cache")
-    old = os.environ.get("FEGEAR_CACHE")
-    os.environ["FEGEAR_CACHE"] = str(root)
-    yield root
+def pytest_configure(config: pytest.Config) -> None:
+    """Point ``$FEGEAR_CACHE`` at a fresh folder before any test module is imported: the tests
+    start cold and never read or write the user's cache (the per-user cache folder, or a
+    ``$FEGEAR_CACHE`` of the shell, which this overrides); subprocesses inherit it. Removed,
+    and the old value restored, at the end of the session (a face-gear cache is ~100 MB)."""
+    root = tempfile.mkdtemp(prefix="fegear_test_cache_")
+    config._fegear_cache = (root, os.environ.get("FEGEAR_CACHE"))  # type: ignore[attr-defined]
+    os.environ["FEGEAR_CACHE"] = root
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    root, old = getattr(config, "_fegear_cache", (None, None))
+    if root is None:
+        return
+    shutil.rmtree(root, ignore_errors=True)
     if old is None:
         os.environ.pop("FEGEAR_CACHE", None)
     else:
         os.environ["FEGEAR_CACHE"] = old
+
+
+@pytest.fixture(scope="session")
+def fegear_cache() -> Path:
+    """The session's private artefact cache folder."""
+    return Path(os.environ["FEGEAR_CACHE"])

@@ -244,17 +244,22 @@ class _Projector:
     Newton line hit of the line through the point along a given direction with the exact flank
     (tooth ``t`` of the member placed by ``M``)."""
 
-    def __init__(self, fm, n: int = 41) -> None:
-        from scipy.spatial import cKDTree
-
-        b = fm.bounds
-        U, V = np.meshgrid(np.linspace(b.u_fillet, b.u_tip, n), np.linspace(b.v_start, b.v_end, n),
-                           indexing="ij")  # fmt: skip
+    def __init__(self, fm, n: int = 21) -> None:
         self.fm = fm
-        self.a, self.b = (x.ravel() for x in fm.native(U.ravel(), V.ravel()))
-        self.tree = cKDTree(fm.evaluate(self.a, self.b)[0])
+        self.n = n
+        self.tree = None
 
     def start(self, P: Array) -> tuple[Array, Array]:
+        """Start values of the native parameters: the nearest of ``n × n`` flank samples (the
+        TCA's start grid size)."""
+        if self.tree is None:
+            from scipy.spatial import cKDTree
+
+            b, n = self.fm.bounds, self.n
+            U, V = np.meshgrid(np.linspace(b.u_fillet, b.u_tip, n),
+                               np.linspace(b.v_start, b.v_end, n), indexing="ij")  # fmt: skip
+            self.a, self.b = (x.ravel() for x in self.fm.native(U.ravel(), V.ravel()))
+            self.tree = cKDTree(self.fm.evaluate(self.a, self.b)[0])
         i = self.tree.query(P)[1]
         return self.a[i], self.b[i]
 
@@ -269,22 +274,23 @@ class _Projector:
 def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
     """The loaded cells of both members at every position of a loaded
     :class:`~fegear.io.gear_run.GearRun`, in flank coordinates (empty for the ``hertz``
-    fidelity, which has no contact cells, and at positions without load)."""
+    fidelity, which has no contact cells, and at positions without load).
+
+    The Newton solves of all cells of all positions run as one batch per member and stage
+    (gear cell centres, then the corners of both members from their centres).
+    """
     from fegear.assembly import tooth_transform
     from fegear.geometry.transforms import apply_points, apply_vectors, compose, inverse
 
     cyc = run.cycle
-    out: list[dict[str, FlankPatch]] = []
     if cyc is None:
-        return out
+        return []
     maps = maps or _maps(run)
     frames = frames or flank_frames(run, maps)
     asm = run.assembly
-    proj: dict[str, _Projector] = {}
-    failed = 0
+    # 1. the loaded cells of every position and pair, in each member's tooth frame
+    blocks: list[dict[str, Any]] = []
     for i, pos in enumerate(cyc.positions):
-        here = {m: FlankPatch.empty(m) for m in MEMBERS}
-        rows: dict[str, list] = {m: [] for m in MEMBERS}
         offset = 0
         for ip, (c, p) in enumerate(zip(pos.cells, pos.pressure, strict=True)):
             sl = slice(offset, offset + c.n)
@@ -292,58 +298,73 @@ def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
             load = np.flatnonzero(p > 0)
             if load.size == 0:
                 continue
-            force = pos.solution.force[sl][load]
-            corners = _cell_corners(c)[load]
-            normals = c.normals[load]
+            corners, normals = _cell_corners(c)[load], c.normals[load]
+            gap = c.gap[load]
+            row = {"i": i, "ip": ip, "p": p[load], "f": pos.solution.force[sl][load],
+                   "edge": c.boundary[load], "k": c.k, "j": c.j}  # fmt: skip
             for member in MEMBERS:
-                fm = maps[member]
-                if member not in proj:
-                    proj[member] = _Projector(fm)
-                pj = proj[member]
                 if member == "pinion":
                     M = compose(asm.placement1(pos.phi1), tooth_transform(asm.n1, c.k))
-                    X0 = c.centers[load]
-                    Xc = corners
-                    u0, v0 = c.uv[load, 0], c.uv[load, 1]
-                    a0, b0 = fm.native(u0, v0)
-                else:
+                    X0, Xc = c.centers[load], corners
+                else:  # the pinion cell carried along the pinion normal by its gap
                     M = compose(asm.placement2(run.phi2[i]), tooth_transform(asm.n2, c.j))
-                    gap = c.gap[load]
                     X0 = c.centers[load] + gap[:, None] * normals
                     Xc = corners + gap[:, None, None] * normals[:, None, :]
                 Mi = inverse(M)
-                Nm = apply_vectors(Mi, normals)
-                if member == "gear":
-                    P0 = apply_points(Mi, X0)
-                    u0, v0, a0, b0, ok0 = pj(P0, Nm, *pj.start(P0))
-                    failed += int(np.count_nonzero(~ok0))
-                Pc = apply_points(Mi, Xc)
-                Nc = np.broadcast_to(Nm[:, None, :], Pc.shape)
-                A0 = np.broadcast_to(np.asarray(a0)[:, None], Pc.shape[:2])
-                B0 = np.broadcast_to(np.asarray(b0)[:, None], Pc.shape[:2])
-                uc, vc, _, _, okc = pj(Pc, Nc, A0, B0)
-                bad = ~okc
-                if bad.any():  # a corner the Newton did not reach: the cell shrinks to its centre
-                    failed += int(np.count_nonzero(bad))
-                    uc = np.where(bad, np.asarray(u0)[:, None], uc)
-                    vc = np.where(bad, np.asarray(v0)[:, None], vc)
-                fr = frames[member]
-                rows[member].append(
-                    (
-                        fr.coordinates(uc, vc),
-                        fr.coordinates(np.asarray(u0), np.asarray(v0)),
-                        p[load],
-                        force,
-                        np.full(load.size, c.k if member == "pinion" else c.j, np.int64),
-                        np.full(load.size, ip, np.int64),
-                        c.boundary[load],
-                    )
+                row[member] = (
+                    apply_points(Mi, X0),
+                    apply_points(Mi, Xc),
+                    apply_vectors(Mi, normals),
                 )
-        for member in MEMBERS:
-            if rows[member]:
-                cols = [np.concatenate(x) for x in zip(*rows[member], strict=True)]
-                here[member] = FlankPatch(member, *cols)
-        out.append(here)
+            row["uv1"] = c.uv[load]
+            blocks.append(row)
+    out = [{m: FlankPatch.empty(m) for m in MEMBERS} for _ in cyc.positions]
+    if not blocks:
+        return out
+    sizes = np.array([len(b["p"]) for b in blocks])
+    failed = 0
+    coords: dict[str, tuple[Array, Array]] = {}
+    for member in MEMBERS:
+        fm, fr = maps[member], frames[member]
+        pj = _Projector(fm)
+        P0 = np.concatenate([b[member][0] for b in blocks])
+        Pc = np.concatenate([b[member][1] for b in blocks])
+        N = np.concatenate([b[member][2] for b in blocks])
+        if member == "pinion":  # the cells are laid out on the pinion flank: centres known
+            uv0 = np.concatenate([b["uv1"] for b in blocks])
+            u0, v0 = uv0[:, 0], uv0[:, 1]
+            a0, b0 = fm.native(u0, v0)
+        else:
+            u0, v0, a0, b0, ok0 = pj(P0, N, *pj.start(P0))
+            failed += int(np.count_nonzero(~ok0))
+        shape = Pc.shape[:2]
+        uc, vc, _, _, okc = pj(
+            Pc, np.broadcast_to(N[:, None, :], Pc.shape),
+            np.broadcast_to(np.asarray(a0)[:, None], shape),
+            np.broadcast_to(np.asarray(b0)[:, None], shape),
+        )  # fmt: skip
+        bad = ~okc
+        if bad.any():  # a corner the Newton did not reach: drawn at its cell's centre
+            failed += int(np.count_nonzero(bad))
+            uc = np.where(bad, np.asarray(u0)[:, None], uc)
+            vc = np.where(bad, np.asarray(v0)[:, None], vc)
+        coords[member] = (fr.coordinates(uc, vc), fr.coordinates(np.asarray(u0), np.asarray(v0)))
+    # 2. back to positions
+    cuts = np.cumsum(sizes)[:-1]
+    for member in MEMBERS:
+        quads = np.split(coords[member][0], cuts)
+        centres = np.split(coords[member][1], cuts)
+        rows: dict[int, list] = {}
+        for b, q, c in zip(blocks, quads, centres, strict=True):
+            n = len(b["p"])
+            tooth = b["k"] if member == "pinion" else b["j"]
+            rows.setdefault(b["i"], []).append(
+                (q, c, b["p"], b["f"], np.full(n, tooth, np.int64), np.full(n, b["ip"], np.int64),
+                 b["edge"])
+            )  # fmt: skip
+        for i, parts in rows.items():
+            cols = [np.concatenate(x) for x in zip(*parts, strict=True)]
+            out[i][member] = FlankPatch(member, *cols)
     if failed:
         log.warning("flank views: %d cell points not found on the exact flank (drawn at the "
                     "cell centre)", failed)  # fmt: skip
@@ -568,7 +589,7 @@ def plot_flank_pattern(
         xy = np.concatenate([c for _, c in force])
         cx, cy = (w @ xy) / w.sum()
         ax.plot([cx], [cy], "c+", ms=14, mew=2, label="pattern centre (force-weighted)")
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="lower right")
     o = frame.outline
     ax.plot(o[:, 0], o[:, 1], "k-", lw=1)
     a, b = frame.face_ends

@@ -1,0 +1,168 @@
+"""The artefact cache in the per-user cache folder (issue 22).
+
+- ``$FEGEAR_CACHE`` wins, else the platform's per-user cache folder: never a folder under the
+  current working directory, so two fresh working directories share one cache (the second run
+  of the same case from another folder is warm: asserted by the cache hits it reports, not by
+  its timing).
+- ``fegear cache info`` says where the cache is and what it holds; ``fegear cache clear``
+  deletes artefacts (all, or one ``--kind``) and refuses a folder that is not a fegear cache.
+- The test suite itself runs on a private cache (``tests/conftest.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+
+import platformdirs
+import pytest
+
+from fegear.cli import main
+from fegear.mesh import cache as fcache
+
+REPO = Path(__file__).resolve().parents[1]
+FZG = REPO / "cases" / "fzg_spur.toml"
+
+
+def _user_cache_in(monkeypatch, tmp_path: Path) -> Path:
+    """Unset ``$FEGEAR_CACHE`` and point the platform's per-user cache folder into ``tmp_path``
+    (XDG on Linux, HOME on macOS); returns the cache root, checked to lie there (the test must
+    never write into the real user cache)."""
+    if sys.platform.startswith("win"):
+        pytest.skip("the per-user cache folder of Windows cannot be redirected by environment")
+    monkeypatch.delenv("FEGEAR_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    if sys.platform == "darwin":
+        monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    root = fcache.cache_root()
+    assert root == Path(platformdirs.user_cache_dir("fegear", appauthor=False))
+    assert tmp_path in root.parents, root
+    return root
+
+
+def test_the_suite_runs_on_a_private_cache():
+    """conftest.py points ``$FEGEAR_CACHE`` at a temporary folder for the whole session."""
+    root = fcache.cache_root()
+    assert os.environ["FEGEAR_CACHE"] and root == Path(os.environ["FEGEAR_CACHE"])
+    assert root != Path(platformdirs.user_cache_dir("fegear", appauthor=False))
+    assert root.name.startswith("fegear_test_cache_")
+
+
+def test_root_is_fegear_cache_else_the_user_cache_folder(monkeypatch, tmp_path):
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "mine"))
+    assert fcache.cache_root() == tmp_path / "mine"
+    root = _user_cache_in(monkeypatch, tmp_path)
+    for name in ("a", "b"):  # the same root from any working directory
+        (tmp_path / name).mkdir()
+        monkeypatch.chdir(tmp_path / name)
+        assert fcache.cache_root() == root
+
+
+def _case(tmp_path: Path) -> Path:
+    text = FZG.read_text(encoding="utf-8").replace("n_positions = 9", "n_positions = 3")
+    path = tmp_path / "fzg3.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_two_working_directories_share_one_cache(monkeypatch, tmp_path):
+    """``fegear run`` of the same case from two fresh folders: the first builds the meshes,
+    operators and TCA in the per-user cache, the second reads every one of them back."""
+    root = _user_cache_in(monkeypatch, tmp_path)
+    case = _case(tmp_path)
+    docs = []
+    for name in ("first", "second"):
+        work = tmp_path / name
+        work.mkdir()
+        monkeypatch.chdir(work)
+        assert main(["run", str(case), "-q", "--workers", "1"]) == 0
+        docs.append(json.loads((work / "out" / "summary.json").read_text()))
+        assert not (work / "meshes").exists()  # nothing cached under the working directory
+    first, second = (d["cache"] for d in docs)
+    assert first["folder"] == second["folder"] == str(root)
+    assert {"mesh", "compliance", "tca"} <= set(first["built"])
+    # warm: every artefact the first run built, the second read; it built nothing
+    assert second["built"] == {}
+    assert set(first["built"]) <= set(second["hits"])
+    assert second["hits"]["mesh"] >= first["built"]["mesh"]
+    assert docs[0]["cycle"]["te_pp_loaded_arcsec"] == docs[1]["cycle"]["te_pp_loaded_arcsec"]
+    assert (root / fcache.CACHE_TAG).read_text().startswith("Signature: 8a477f597d28d172")
+
+
+@pytest.mark.slow
+def test_main_job_from_two_folders_shares_one_cache(monkeypatch, tmp_path):
+    """The main job (``fegear run``, the seed face gear at hybrid level 0, ~1 min cold) from two
+    fresh folders: the second run is warm."""
+    _user_cache_in(monkeypatch, tmp_path)
+    docs = []
+    for name in ("first", "second"):
+        work = tmp_path / name
+        work.mkdir()
+        monkeypatch.chdir(work)
+        assert main(["run", "-q"]) == 0
+        docs.append(json.loads((work / "out" / "summary.json").read_text()))
+    assert {"mesh", "compliance"} <= set(docs[0]["cache"]["built"])
+    assert docs[1]["cache"]["built"] == {} and docs[1]["cache"]["hits"]["compliance"] >= 2
+
+
+# --------------------------------------------------------------------------------------------
+# fegear cache info / clear
+# --------------------------------------------------------------------------------------------
+
+
+def _fill(kind: str, n: int) -> None:
+    for i in range(n):
+        fcache.cached_file(kind, {"i": i}, ".bin", lambda p, i=i: p.write_bytes(b"x" * (i + 1)))
+
+
+def test_cache_info_and_clear(monkeypatch, tmp_path, capsys):
+    root = tmp_path / "c"
+    monkeypatch.setenv("FEGEAR_CACHE", str(root))
+    assert main(["cache", "info"]) == 0
+    assert "empty" in capsys.readouterr().out
+    _fill("alpha", 3)
+    _fill("beta", 2)
+    info = fcache.cache_info()
+    assert info.is_cache and info.source == "FEGEAR_CACHE"
+    assert [(k.kind, k.files, k.bytes) for k in info.kinds] == [("alpha", 3, 6), ("beta", 2, 3)]
+    assert main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert str(root) in out and "FEGEAR_CACHE" in out
+    assert any(ln.split()[:3] == ["alpha", "3", "files"] for ln in out.splitlines())
+    assert any(ln.split()[:3] == ["total", "5", "files"] for ln in out.splitlines())
+    assert main(["cache", "clear", "--kind", "alpha"]) == 0
+    assert "removed 3 files" in capsys.readouterr().out
+    assert [k.kind for k in fcache.cache_info().kinds] == ["beta"]
+    assert main(["cache", "clear", "--kind", "gamma"]) == 2  # not a kind of the cache
+    assert "--kind" in capsys.readouterr().err
+    (root / "notes.txt").write_text("mine")  # not an artefact: stays
+    assert main(["cache", "clear"]) == 0
+    assert fcache.cache_info().files == 0 and (root / "notes.txt").read_text() == "mine"
+
+
+def test_clear_refuses_a_folder_that_is_not_a_fegear_cache(monkeypatch, tmp_path, capsys):
+    root = tmp_path / "home"
+    (root / "mesh").mkdir(parents=True)
+    (root / "mesh" / "thesis.tex").write_text("precious")
+    (root / "0123456789abcdef0123.npy").write_text("looks like an artefact, but no tag")
+    monkeypatch.setenv("FEGEAR_CACHE", str(root))
+    assert main(["cache", "clear"]) == 2
+    err = capsys.readouterr().err
+    assert "not allowed" in err and "fegear cache folder" in err and "nothing was deleted" in err
+    assert (root / "mesh" / "thesis.tex").read_text() == "precious"
+    assert (root / "0123456789abcdef0123.npy").exists()
+
+
+def test_a_cache_of_an_older_fegear_is_recognised_by_its_layout(monkeypatch, tmp_path):
+    """``meshes/cache`` of earlier versions has no tag: kind folders of content-hash files."""
+    root = tmp_path / "meshes" / "cache"
+    (root / "compliance").mkdir(parents=True)
+    (root / "compliance" / "0123456789abcdef0123.npy").write_bytes(b"1234")
+    (root / "tca").mkdir()
+    (root / "tca" / ".0123456789abcdef0123.k2j3_x.pkl").write_bytes(b"12")  # a dead temp file
+    monkeypatch.setenv("FEGEAR_CACHE", str(root))
+    assert fcache.is_cache_folder(root)
+    gone = fcache.clear_cache()
+    assert (gone.files, gone.bytes) == (2, 6) and not any(root.iterdir())

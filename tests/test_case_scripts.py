@@ -1,0 +1,166 @@
+"""The case scripts of ``cases/*.py`` run as tests, the way the dolfinx demos do (issue 22).
+
+Each script is loaded from its file and its ``main(fidelity=..., out=...)`` is run, then what the
+script is for is checked on the results it returns (where the bearing pattern goes, what happens
+to the TE and the contact ratio) and on the pictures it wrote. The fidelity is the fastest that
+shows it: ``tca`` (the unloaded pattern and TE shifts), or ``$FEGEAR_SCRIPT_FIDELITY``
+(``FEGEAR_SCRIPT_FIDELITY=hybrid pytest tests/test_case_scripts.py`` runs them loaded: the same
+checks hold, the pattern centre is then the force-weighted centroid of the loaded cells).
+
+Every script in ``cases/`` must have its checks here (a new script without them fails).
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SCRIPTS = sorted((REPO / "cases").glob("*.py"))
+FIDELITY = os.environ.get("FEGEAR_SCRIPT_FIDELITY", "tca")
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _main(name: str):
+    """The script's ``main`` (the module is executed as a module, not as ``__main__``)."""
+    return runpy.run_path(str(REPO / "cases" / f"{name}.py"), run_name="case_script")["main"]
+
+
+def _shift(results, label, ref):
+    """``(Δface, Δprofile)`` mm of the gear-flank pattern centre of ``label`` against ``ref``."""
+    p, q = results[label].pattern["gear"], results[ref].pattern["gear"]
+    return p.face_mm - q.face_mm, p.profile_mm - q.profile_mm
+
+
+def _te_mean(r) -> float:
+    return float(r.te_unloaded_arcsec.mean())
+
+
+def _pictures(out: Path) -> None:
+    for name in ("te.png", "pattern.png"):
+        assert (out / name).read_bytes()[:8] == PNG, name
+
+
+def _printed_table(text: str, labels) -> None:
+    rows = [ln for ln in text.splitlines() if ln.startswith("| ")]
+    assert len(rows) == 1 + len(labels), text  # the header and one row per run
+    for label in labels:
+        assert any(r.startswith(f"| {label} |") for r in rows), label
+
+
+def test_every_script_has_checks():
+    names = {p.stem for p in SCRIPTS}
+    assert names == set(CHECKS), f"scripts without checks: {names - set(CHECKS)}"
+
+
+def check_face_gear_dE(results, out):
+    minus, zero, plus = results  # ΔE = -0.1, 0, +0.1 mm
+    d_plus, _ = _shift(results, plus, zero)
+    d_minus, _ = _shift(results, minus, zero)
+    # ΔE > 0 slides the pattern toward the inner end, ΔE < 0 toward the outer end: measured
+    # -3.7 / +4.0 mm at tca (26 positions of 0.4 mm spacing along the path: > 2 mm is the shift)
+    assert d_plus < -2.0 and d_minus > 2.0, (d_plus, d_minus)
+    # the unloaded TE moves by a constant of about 40 arcsec per 0.1 mm, sign of ΔE
+    assert _te_mean(results[plus]) - _te_mean(results[zero]) > 20.0
+    assert _te_mean(results[minus]) - _te_mean(results[zero]) < -20.0
+    cr = [results[k].checks.contact_ratio_unloaded for k in results]
+    assert cr[0] < cr[1] < cr[2], cr  # 1.526, 1.554, 1.582
+
+
+def check_face_gear_dA1(results, out):
+    minus, zero, plus = results  # ΔA1 = -0.5, 0, +0.5 mm
+    for label in (minus, plus):
+        d_face, d_prof = _shift(results, label, zero)
+        # the spur pinion slides along its own uniform tooth: the contact does not move (to the
+        # Newton tolerance at tca; loaded: the contact moves 0.5 mm along the pinion's sector,
+        # whose compliance is nearly the same there)
+        assert abs(d_face) < 0.05 and abs(d_prof) < 0.01, (label, d_face, d_prof)
+        assert abs(_te_mean(results[label]) - _te_mean(results[zero])) < 0.05
+        cr, cr0 = results[label].checks.contact_ratio_unloaded, results[zero].checks
+        assert cr == pytest.approx(cr0.contact_ratio_unloaded, abs=1e-6)
+
+
+def check_face_gear_dA2(results, out):
+    minus, zero, plus = results  # Δq = -0.1, 0, +0.1 mm
+    d_plus, _ = _shift(results, plus, zero)
+    d_minus, _ = _shift(results, minus, zero)
+    # Δq > 0 (a shallower mesh) toward the inner end: measured -8.0 / +7.9 mm at tca
+    assert d_plus < -5.0 and d_minus > 5.0, (d_plus, d_minus)
+    # a constant TE shift of about 18-20 arcsec per 0.1 mm, against the sign of Δq
+    assert _te_mean(results[plus]) - _te_mean(results[zero]) < -10.0
+    assert _te_mean(results[minus]) - _te_mean(results[zero]) > 10.0
+
+
+def check_face_gear_dgamma(results, out):
+    minus, zero, plus = results  # Δγ = -0.02, 0, +0.02 deg
+    d_plus, _ = _shift(results, plus, zero)
+    d_minus, _ = _shift(results, minus, zero)
+    # the strongest mover: measured +19.3 / -15.7 mm at tca (docs/tca: the same run)
+    assert d_plus > 10.0 and d_minus < -10.0, (d_plus, d_minus)
+    cr = [results[k].checks.contact_ratio_unloaded for k in results]
+    # the contact ratio falls with Δγ: 1.642, 1.554, 1.441 (docs/tca)
+    assert cr[0] > cr[1] > cr[2], cr
+    assert cr[1] == pytest.approx(1.554, abs=0.01)  # the seed's, measured 1.554
+
+
+def check_spiral_bevel_vh(results, out):
+    assert set(results) >= {"nominal", "ΔE = +0.05 mm"}
+    v_e, h_e = _shift(results, "ΔE = +0.05 mm", "nominal")
+    # ΔE is the lengthwise mover: docs/tca measured V = -2.95 mm (toward the toe) and
+    # H = +0.34 mm (toward the top) for +0.05 mm
+    assert v_e < -1.5 and h_e > 0.1, (v_e, h_e)
+    if "ΔG = +0.05 mm" in results:
+        v_g, _ = _shift(results, "ΔG = +0.05 mm", "nominal")
+        v_p, _ = _shift(results, "ΔP = +0.05 mm", "nominal")
+        # ΔG moves it the other way, about a third as far (+1.0 mm); ΔP hardly (+0.25 mm)
+        assert v_g > 0.3 and abs(v_p) < abs(v_g) < abs(v_e), (v_e, v_g, v_p)
+    for r in results.values():
+        # the designed parabolic TE of ~8 arcsec survives 0.05 mm of each error (7-9 arcsec)
+        assert 4.0 < r.cycle.te_pp_unloaded_arcsec < 14.0, r.cycle.te_pp_unloaded_arcsec
+
+
+CHECKS = {
+    "face_gear_dE": check_face_gear_dE,
+    "face_gear_dA1": check_face_gear_dA1,
+    "face_gear_dA2": check_face_gear_dA2,
+    "face_gear_dgamma": check_face_gear_dgamma,
+    "spiral_bevel_vh": check_spiral_bevel_vh,
+}
+
+
+@pytest.mark.parametrize("name", [n for n in CHECKS if n.startswith("face_gear")])
+def test_face_gear_script(name, tmp_path, capsys):
+    """Each face-gear script: three runs of the seed face gear (the error-free one is shared
+    through the cache), the table printed, the pictures written."""
+    results = _main(name)(fidelity=FIDELITY, out=str(tmp_path))
+    assert list(results) and all(r.fidelity == FIDELITY for r in results.values())
+    _printed_table(capsys.readouterr().out, list(results))
+    _pictures(tmp_path)
+    CHECKS[name](results, tmp_path)
+
+
+def test_spiral_bevel_vh_script_on_dE(tmp_path, capsys):
+    """The V/H script on ΔE alone at 5 positions (the machine-setting synthesis, ~15 s, once per
+    process; the runs are those of the bevel smoke tests of tests/test_gear_cli.py, cached):
+    the strong lengthwise mover. All three errors: the slow test below."""
+    main = _main("spiral_bevel_vh")
+    errors = {"ΔE = +0.05 mm": {"dE_mm": 0.05}}
+    results = main(fidelity=FIDELITY, out=str(tmp_path), errors=errors, n_positions=5)
+    out = capsys.readouterr().out
+    _printed_table(out, list(results))
+    assert "ΔE = +0.05 mm" in out and " V " in out and " H " in out
+    _pictures(tmp_path)
+    check_spiral_bevel_vh(results, tmp_path)
+
+
+@pytest.mark.slow
+def test_spiral_bevel_vh_script(tmp_path, capsys):
+    """The V/H script as shipped: ΔE, ΔP and ΔG at 13 positions (~1 min at tca)."""
+    results = _main("spiral_bevel_vh")(fidelity=FIDELITY, out=str(tmp_path))
+    assert len(results) == 4
+    _printed_table(capsys.readouterr().out, list(results))
+    _pictures(tmp_path)
+    check_spiral_bevel_vh(results, tmp_path)
