@@ -1,7 +1,10 @@
 """Pictures of docs/cli/README.md from a finished run: ``python docs/cli/make_pictures.py OUT``.
 
-Copies the PNGs of the run and renders position 12 of ``OUT/cycle.pvd`` off-screen with pyvista
-(what ParaView shows after *Warp By Vector* and colouring by ``pressure_MPa``).
+Copies the PNGs of the run, renders position 12 of ``OUT/cycle.pvd`` off-screen with pyvista
+(what ParaView shows after *Warp By Vector* and colouring by ``pressure_MPa``), renders the gear
+flank view of the same position (``vtk/flank_gear_012.vtp``: the loaded cells on the face-gear
+flank in flank coordinates) and draws the bearing pattern over the cycle on the gear flank
+(what ``fegear plot OUT`` writes).
 """
 
 from __future__ import annotations
@@ -21,7 +24,8 @@ def main(out: Path) -> None:
     reader = pv.get_reader(str(out / "cycle.pvd"))
     i = min(12, reader.number_time_points - 1)
     reader.set_active_time_value(reader.time_values[i])
-    pinion, gear, cells = reader.read()
+    blocks = reader.read()  # parts: pinion, gear, contact cells, pinion / gear flank views
+    pinion, gear, cells = blocks[0], blocks[1], blocks[2]
     pv.OFF_SCREEN = True
     pl = pv.Plotter(off_screen=True, window_size=(1100, 750))
     scale = 200.0  # displacements are µm: exaggerated as in ParaView's Warp By Vector
@@ -44,6 +48,18 @@ def main(out: Path) -> None:
                 f"displacement x{scale:.0f}", font_size=10)  # fmt: skip
     pl.screenshot(str(HERE / "paraview_view.png"))
     pl.close()
+    flank = blocks[4]  # the gear flank view: x face coordinate, y profile coordinate (mm)
+    pl = pv.Plotter(off_screen=True, window_size=(1100, 500))
+    pl.add_mesh(flank, scalars="pressure_MPa", cmap="inferno",
+                scalar_bar_args={"title": "pressure (MPa)"})  # fmt: skip
+    pl.view_xy()
+    pl.add_text(f"gear flank view, position {i} ({flank.field_data['x_axis'][0]} across, "
+                f"{flank.field_data['y_axis'][0]} up)", font_size=9)  # fmt: skip
+    pl.screenshot(str(HERE / "flank_view.png"))
+    pl.close()
+    from fegear.cli import main as fegear
+
+    fegear(["plot", str(out), "--member", "gear", "--png", str(HERE / "gear_flank_pattern.png")])
 
 
 if __name__ == "__main__":

@@ -721,9 +721,8 @@ def build_pair(case: GearCase) -> GearPair:
             except InputError as exc:
                 raise _renamed(exc, i, _SPUR_FIELDS, case) from exc
         return GearPair(members[0], members[1], involute_assembly(*members, case.errors))
-    # spiral bevel: the synthesis (~10-20 s) is cached per process for the same blank data
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
-    from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
+    # spiral bevel: the synthesis (~10-20 s) is cached per process and on disk for the same
+    # blank data (_bevel_pair)
 
     blank_kw = {
         "n1": int(p["n_pinion"]),
@@ -742,14 +741,41 @@ def build_pair(case: GearCase) -> GearPair:
     key = (tuple(sorted(blank_kw.items())), tuple(sorted(target_kw.items())))
     try:
         if key not in _BEVEL_CACHE:
-            _BEVEL_CACHE[key] = SpiralBevelPair.design(
-                SpiralBevelBlank(**blank_kw), SynthesisTargets(**target_kw)
-            )
+            _BEVEL_CACHE[key] = _bevel_pair(blank_kw, target_kw)
         sb = _BEVEL_CACHE[key]
     except InputError as exc:
         raise _renamed(exc, None, _BEVEL_FIELDS, case) from exc
     side = p.get("side", "drive")
     return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
+
+
+def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
+    """The synthesized spiral bevel pair of the blank data: read from the artefact cache when
+    the same blank and targets were synthesized before by the same geometry code (the
+    synthesis takes 10-20 s; its pickle loads in a millisecond), else synthesized and cached.
+    The key holds a hash of the source of the geometry and TCA packages
+    (:func:`fegear.tca.cached._source_hash`): a change of the synthesis invalidates it."""
+    import pickle
+
+    from fegear.geometry.spiral_bevel import SpiralBevelPair
+    from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
+    from fegear.mesh.cache import cached_file
+    from fegear.tca.cached import _source_hash
+
+    box: dict[str, Any] = {}
+
+    def build(path: Path) -> None:
+        # a design error raises here, before anything is written (nothing is cached)
+        box["pair"] = SpiralBevelPair.design(
+            SpiralBevelBlank(**blank_kw), SynthesisTargets(**target_kw)
+        )
+        path.write_bytes(pickle.dumps(box["pair"], protocol=pickle.HIGHEST_PROTOCOL))
+
+    params = {"blank": blank_kw, "targets": target_kw, "source": _source_hash()}
+    path, hit = cached_file("bevel_pair", params, ".pkl", build)
+    if not hit:
+        return box["pair"]
+    return pickle.loads(path.read_bytes())
 
 
 def error_fields(case: GearCase) -> list[tuple[str, float]]:
