@@ -112,8 +112,8 @@ class FlankEvaluation:
         ``(..., 2)`` principal curvatures (1/mm, convex positive, descending) and
         ``(..., 2, 3)`` principal directions.
     tool_s, tool_theta, psi
-        Blade parameter s (mm), cutter angle θ (rad) and cradle angle ψ (rad) generating the
-        point.
+        Blade parameter s (mm; on the fillet, ``u < 0``: the edge-radius angle ϑ, rad), cutter
+        angle θ (rad) and cradle angle ψ (rad) generating the point.
     meshing_residual
         ``|n·v|/|v|`` of the equation of meshing at the point.
     """
