@@ -33,10 +33,10 @@ def pitch_point(frame: SectorFrame, side: str = "drive") -> tuple[Array, Array]:
         p = fr.member.point_normal(side, u, np.full_like(u, v))[0]
         rho = np.hypot(p[:, 0], p[:, 1])
         uu = float(np.interp(fr.member.r_p, rho, u))
-    elif hasattr(fr.member, "mean_parameters"):
-        uu, v = fr.member.mean_parameters()
-    else:  # face gear: pitch plane z = 0
-        uu = 0.0
+    elif hasattr(fr.member, "mean_parameters"):  # spiral bevel: mean point on the pitch cone
+        uu, v = fr.member.mean_parameters(side)
+    else:  # face gear: on the pitch plane z = 0 (u is a fraction of the working height)
+        uu = float(fr.member.working_u(0.0, v, side))
     p, n = fr.member.point_normal(side, np.array([uu]), np.array([v]))
     return p[0], n[0]
 
