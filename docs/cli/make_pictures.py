@@ -9,6 +9,7 @@ flank in flank coordinates) and draws the bearing pattern over the cycle on the 
 
 from __future__ import annotations
 
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -49,12 +50,15 @@ def main(out: Path) -> None:
     pl.screenshot(str(HERE / "paraview_view.png"))
     pl.close()
     flank = blocks[4]  # the gear flank view: x face coordinate, y profile coordinate (mm)
-    pl = pv.Plotter(off_screen=True, window_size=(1100, 500))
-    pl.add_mesh(flank, scalars="pressure_MPa", cmap="inferno",
-                scalar_bar_args={"title": "pressure (MPa)"})  # fmt: skip
+    p_max = json.loads((out / "summary.json").read_text())["cycle"]["p_max_MPa"]
+    pl = pv.Plotter(off_screen=True, window_size=(1100, 560))
+    pl.add_mesh(flank, scalars="pressure_MPa", cmap="inferno", clim=[0.0, p_max],
+                line_width=2, scalar_bar_args={"title": "pressure (MPa)"})  # fmt: skip
+    pl.set_scale(yscale=4.0)  # the flank is 6x wider than high: profile stretched 4x
     pl.view_xy()
+    pl.camera.zoom(1.6)
     pl.add_text(f"gear flank view, position {i} ({flank.field_data['x_axis'][0]} across, "
-                f"{flank.field_data['y_axis'][0]} up)", font_size=9)  # fmt: skip
+                f"{flank.field_data['y_axis'][0]} up, x4)", font_size=9)  # fmt: skip
     pl.screenshot(str(HERE / "flank_view.png"))
     pl.close()
     from fegear.cli import main as fegear
