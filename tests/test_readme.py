@@ -113,3 +113,18 @@ def test_command_line_parses(path, line):
     except SystemExit as exc:  # argparse's refusal (exit 2); --help and --version exit 0
         if exc.code not in (0, None):
             pytest.fail(f"{path.name}: {line!r} does not parse (argparse exit {exc.code})")
+
+
+@pytest.mark.parametrize("command", ["run", "sweep"])
+def test_help_names_every_gear_fidelity(command, capsys):
+    """``fegear run --help`` and ``fegear sweep --help`` list every fidelity of the gear
+    pairs (the sweep's once lacked ``hybrid``, the default)."""
+    from fegear.io.gear_case import FIDELITIES
+
+    with pytest.raises(SystemExit):
+        parser().parse_args([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    start = text.rindex("--fidelity FIDELITY") + len("--fidelity FIDELITY")  # options, not usage
+    help_text = text[start : start + 400]
+    for fid in FIDELITIES:
+        assert re.search(rf"\b{fid}\b", help_text), (command, fid, help_text)
