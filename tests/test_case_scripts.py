@@ -4,8 +4,10 @@ Each script is loaded from its file and its ``main(fidelity=..., out=...)`` is r
 script is for is checked on the results it returns (where the bearing pattern goes, what happens
 to the TE and the contact ratio) and on the pictures it wrote. The fidelity is the fastest that
 shows it: ``tca`` (the unloaded pattern and TE shifts), or ``$FEGEAR_SCRIPT_FIDELITY``
-(``FEGEAR_SCRIPT_FIDELITY=hybrid pytest tests/test_case_scripts.py`` runs them loaded: the same
-checks hold, the pattern centre is then the force-weighted centroid of the loaded cells).
+(``FEGEAR_SCRIPT_FIDELITY=hybrid pytest tests/test_case_scripts.py`` runs them loaded, ~15 min
+cold: the pattern centre is then the force-weighted centroid of the loaded cells; the face-gear
+checks are the same, the bevel's bounds are those measured loaded — both ran at hybrid, the
+bevel's on ΔE only).
 
 Every script in ``cases/`` must have its checks here (a new script without them fails).
 """
@@ -114,13 +116,17 @@ def check_spiral_bevel_vh(results, out):
     assert set(results) >= {"nominal", "ΔE = +0.05 mm"}
     v_e, h_e = _shift(results, "ΔE = +0.05 mm", "nominal")
     # ΔE is the lengthwise mover: docs/tca measured V = -2.95 mm (toward the toe) and
-    # H = +0.34 mm (toward the top) for +0.05 mm
-    assert v_e < -1.5 and h_e > 0.1, (v_e, h_e)
+    # H = +0.34 mm (toward the top) for +0.05 mm on the unloaded path. Loaded, the centre is
+    # the force-weighted centroid of patches spread over the flank, which moves less: measured
+    # V = -1.20 mm, H = +0.09 mm at hybrid level 0 (5 positions). Half of each, as the bound.
+    loaded = next(iter(results.values())).fidelity != "tca"
+    v_min, h_min, g_min = (0.6, 0.04, 0.1) if loaded else (1.5, 0.1, 0.3)
+    assert v_e < -v_min and h_e > h_min, (v_e, h_e)
     if "ΔG = +0.05 mm" in results:
         v_g, _ = _shift(results, "ΔG = +0.05 mm", "nominal")
         v_p, _ = _shift(results, "ΔP = +0.05 mm", "nominal")
         # ΔG moves it the other way, about a third as far (+1.0 mm); ΔP hardly (+0.25 mm)
-        assert v_g > 0.3 and abs(v_p) < abs(v_g) < abs(v_e), (v_e, v_g, v_p)
+        assert v_g > g_min and abs(v_p) < abs(v_g) < abs(v_e), (v_e, v_g, v_p)
     for r in results.values():
         # the designed parabolic TE of ~8 arcsec survives 0.05 mm of each error (7-9 arcsec)
         assert 4.0 < r.cycle.te_pp_unloaded_arcsec < 14.0, r.cycle.te_pp_unloaded_arcsec
