@@ -16,7 +16,8 @@ localized one runs along it under misalignment; it stays flagged as an edge cont
 - the unloaded contact ratio ``ε = (ψ_out − ψ_in)/τ1``: below 1 the pairs cannot hand the load
   over with their working surfaces,
 - the path: pair 0's contact points on the gear (member 2) flank, in the gear frame, over the
-  interval; its length is the polyline length through the samples and the two ends,
+  interval; its length is the polyline length through the samples and the two ends (a line
+  contact is traced at mid-face: its points lie anywhere along the line),
 - what ends the interval at each end: the edge the pair runs onto (``"gear:tip"``,
   ``"pinion:tip"``, ...) or ``"transfer"`` when another pair takes the contact over first.
 """
@@ -187,6 +188,13 @@ def contact_path(
     phi = np.array([x.psi for x in run])
     uv1 = np.array([x.uv1 for x in run])
     uv2 = np.array([x.uv2 for x in run])
+    if any(p.ellipse is not None and p.ellipse.line_contact for p in positions):
+        # a line contact (conjugate spur pair) touches along the whole face: the TCA's point on
+        # it is its centre only where the tie is resolved; the path is the one at mid-face
+        b1 = tca.fm1.bounds
+        shift = 0.5 * (b1.v_start + b1.v_end) - uv1[:, 1]
+        uv1[:, 1] += shift
+        uv2[:, 1] += shift  # parallel axes: the face coordinates are axial positions of both
     g = tca.fm2.evaluate(*tca.fm2.native(uv2[:, 0], uv2[:, 1]))[0]
     p = tca.fm1.evaluate(*tca.fm1.native(uv1[:, 0], uv1[:, 1]))[0]
     length = float(np.linalg.norm(np.diff(g, axis=0), axis=1).sum())
