@@ -128,3 +128,40 @@ def test_help_names_every_gear_fidelity(command, capsys):
     help_text = text[start : start + 400]
     for fid in FIDELITIES:
         assert re.search(rf"\b{fid}\b", help_text), (command, fid, help_text)
+
+
+def test_readme_is_for_users():
+    """README.md speaks to users about the project as it is (issue 22): at most ~300 lines, no
+    development history, no pointers outside the repository."""
+    text = README.read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 300
+    for word in ("session", "DESIGN §", "../shared", "before/after"):
+        assert word.lower() not in text.lower(), word
+
+
+def _case_table() -> dict[str, set[str]]:
+    """``{section row label: keys}`` of the README's case-file reference table (the backticked
+    words of its second column)."""
+    text = README.read_text(encoding="utf-8")
+    start = text.index("## Case files")
+    rows = {}
+    for line in text[start:].splitlines()[1:]:
+        if line.startswith("## "):
+            break
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) >= 2 and cells[0].startswith("`["):
+            rows[cells[0]] = set(re.findall(r"`([A-Za-z0-9_]+)`", cells[1]))
+    return rows
+
+
+def test_case_file_reference_is_the_schema():
+    """Every key of the gear-case schema is in the README's case-file table under its section,
+    and the table names no key the schema does not know."""
+    from fegear.io import gear_case as gc
+
+    rows = _case_table()
+    expected = {f"`[{s}]`": set(keys) for s, keys in gc._COMMON_SCHEMA.items()}
+    for kind, keys in gc._PAIR_SCHEMA.items():
+        expected[f"`[pair]`, kind `{kind}`"] = set(keys)
+    expected["`[errors]`"] = set(gc._ERRORS_INTERSECTING) | set(gc._ERRORS_PARALLEL)
+    assert rows == expected
