@@ -22,7 +22,6 @@ Gear pairs (``kind = "face_gear" | "spur" | "spiral_bevel"``): see :mod:`fegear.
 from __future__ import annotations
 
 import difflib
-import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,33 +29,123 @@ from typing import Any
 
 from fegear.errors import InputError
 from fegear.io.gear_case import GearCase
+from fegear.io.schema import (
+    INT_LIST,
+    INTEGER,
+    NUMBER,
+    NUMBER_PAIR,
+    STRING,
+    Key,
+    Range,
+    Section,
+    check_document,
+    check_table,
+    reference_markdown,
+)
 from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, HertzScene
 
-__all__ = ["HertzCase", "GearCase", "load_case", "parse_case", "parse_hertz_case"]
+__all__ = [
+    "HertzCase",
+    "GearCase",
+    "load_case",
+    "parse_case",
+    "parse_hertz_case",
+    "reference",
+]
 
-_NUM = (int, float)
+_D = HertzScene()
+_LEVEL = Range(0, len(CELLS_ACROSS_MINOR) - 1)
+_POS = Range(0, None, lo_open=True)
 
-# section -> key -> (type, required)
-_SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], bool]]] = {
-    "case": {"kind": (str, True), "name": (str, False), "description": (str, False)},
-    "load": {"force_N": (_NUM, True)},
-    "roller": {
-        "radii_mm": (list, True),
-        "half_length_mm": (_NUM, False),
-        "E_MPa": (_NUM, False),
-        "nu": (_NUM, False),
-    },
-    "block": {
-        "half_size_mm": (_NUM, False),
-        "height_mm": (_NUM, False),
-        "E_MPa": (_NUM, False),
-        "nu": (_NUM, False),
-    },
-    "mesh": {"level": (int, False), "symmetry": (str, False), "grid_margin": (_NUM, False)},
-    "solver": {"backend": (str, False), "fidelity": (str, False), "fe_level": (int, False)},
-    "study": {"levels": (list, False)},
-}
-_REQUIRED_SECTIONS = ("case", "load", "roller")
+#: The Hertz scene's sections (the engine: :mod:`fegear.io.schema`; the scene checks the
+#: ranges of its own fields, :class:`~fegear.scenes.hertz_scene.HertzScene`).
+SECTIONS: tuple[Section, ...] = (
+    Section(
+        "case",
+        (
+            Key("kind", STRING, '"hertz_scene"', True),
+            Key("name", STRING, "case name (default: the file name)"),
+            Key("description", STRING, "free text", default=""),
+        ),
+        required=True,
+    ),
+    Section("load", (Key("force_N", NUMBER, "normal force, N", True),), required=True),
+    Section(
+        "roller",
+        (
+            Key(
+                "radii_mm",
+                NUMBER_PAIR,
+                "principal radii of curvature, mm",
+                True,
+                labels=("Rx", "Ry"),
+            ),
+            Key(
+                "half_length_mm",
+                NUMBER,
+                "half length of the roller body, mm",
+                default=_D.roller_half_length_mm,
+            ),
+            Key("E_MPa", NUMBER, "Young's modulus, MPa", default=_D.E_roller_MPa),
+            Key("nu", NUMBER, "Poisson's ratio", default=_D.nu_roller),
+        ),
+        required=True,
+    ),
+    Section(
+        "block",
+        (
+            Key(
+                "half_size_mm", NUMBER, "half size of the block, mm", default=_D.block_half_size_mm
+            ),
+            Key("height_mm", NUMBER, "block height, mm", default=_D.block_height_mm),
+            Key("E_MPa", NUMBER, "Young's modulus, MPa", default=_D.E_block_MPa),
+            Key("nu", NUMBER, "Poisson's ratio", default=_D.nu_block),
+        ),
+    ),
+    Section(
+        "mesh",
+        (
+            Key(
+                "level",
+                INTEGER,
+                "mesh level (cells across the minor semi-axis: "
+                f"{', '.join(map(str, CELLS_ACROSS_MINOR))})",
+                default=3,
+                range=_LEVEL,
+            ),
+            Key("symmetry", STRING, '"quarter" or "none"', default=_D.symmetry),
+            Key("grid_margin", NUMBER, "contact grid size / Hertz ellipse", default=_D.grid_margin),
+        ),
+    ),
+    Section(
+        "solver",
+        (
+            Key(
+                "backend",
+                STRING,
+                "sparse direct solver",
+                default="auto",
+                choices=("auto", "pardiso", "superlu"),
+            ),
+            Key("fidelity", STRING, "contact compliance", default="fe", choices=("fe", "hybrid")),
+            Key("fe_level", INTEGER, "hybrid: the FE mesh level", default=0, range=_LEVEL),
+        ),
+    ),
+    Section(
+        "study",
+        (
+            Key(
+                "levels",
+                INT_LIST,
+                "a mesh-convergence study over these levels",
+                default=[],
+                range=_LEVEL,
+            ),
+        ),  # fmt: skip
+    ),
+)
+_SECTION = {s.name: s for s in SECTIONS}
+
 # HertzScene field -> the case-file key that sets it (errors name what the user wrote)
 _SCENE_KEYS = {
     "force_N": "load.force_N",
@@ -174,35 +263,6 @@ _HERTZ_FIELDS = {
 }
 
 
-def _type_name(t: type | tuple[type, ...]) -> str:
-    if t is _NUM:
-        return "a number"
-    return {str: "a string", int: "an integer", list: "a list"}.get(t, str(t))
-
-
-def _check_section(name: str, table: Any) -> dict[str, Any]:
-    if not isinstance(table, dict):
-        raise InputError(name, table, "a TOML table [" + name + "]")
-    schema = _SCHEMA[name]
-    for key, value in table.items():
-        if key not in schema:
-            close = difflib.get_close_matches(key, list(schema), n=1, cutoff=0.5)
-            hint = f"did you mean {close[0]!r}?" if close else ""
-            raise InputError(f"{name}.{key}", value, f"one of the keys {sorted(schema)}", hint)
-        typ, _ = schema[key]
-        ok = isinstance(value, typ) and not (typ is _NUM and isinstance(value, bool))
-        if typ is int and isinstance(value, bool):
-            ok = False
-        if not ok:
-            raise InputError(f"{name}.{key}", value, _type_name(typ))
-        if typ is _NUM and not math.isfinite(value):
-            raise InputError(f"{name}.{key}", value, "a finite number")
-    for key, (_, required) in schema.items():
-        if required and key not in table:
-            raise InputError(f"{name}.{key}", "missing", "present (required)")
-    return table
-
-
 def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase | GearCase:
     """Validate a parsed TOML document and build the case (dispatch on ``[case] kind``)."""
     from fegear.io.gear_case import GEAR_KINDS, parse_gear_case
@@ -226,64 +286,38 @@ def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase | Ge
 
 def parse_hertz_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
     """Validate a parsed Hertz-scene TOML document and build the case."""
-    for key in data:
-        if key not in _SCHEMA:
-            close = difflib.get_close_matches(key, list(_SCHEMA), n=1, cutoff=0.5)
-            raise InputError(
-                key,
-                "[" + key + "]",
-                f"one of the sections {sorted(_SCHEMA)}",
-                f"did you mean [{close[0]}]?" if close else "",
-            )
-    for sec in _REQUIRED_SECTIONS:
-        if sec not in data:
-            raise InputError(sec, "missing", f"a [{sec}] section (required)")
-    sections = {name: _check_section(name, data.get(name, {})) for name in _SCHEMA}
+    check_document(data, SECTIONS)
+    sections = {name: check_table(sec, data.get(name, {})) for name, sec in _SECTION.items()}
     kind = sections["case"]["kind"]
     if kind != "hertz_scene":
         raise InputError("case.kind", kind, "'hertz_scene' (gear cases come with the gear issues)")
     roller, block, mesh = sections["roller"], sections["block"], sections["mesh"]
     radii = roller["radii_mm"]
-    if len(radii) != 2 or not all(isinstance(r, _NUM) and not isinstance(r, bool) for r in radii):
-        raise InputError("roller.radii_mm", radii, "a list of two numbers [Rx, Ry]")
-    defaults = HertzScene()
+    r, b, m = _SECTION["roller"], _SECTION["block"], _SECTION["mesh"]
     try:
         scene = HertzScene(
             force_N=float(sections["load"]["force_N"]),
             roller_radii_mm=(float(radii[0]), float(radii[1])),
-            roller_half_length_mm=float(
-                roller.get("half_length_mm", defaults.roller_half_length_mm)
-            ),
-            block_half_size_mm=float(block.get("half_size_mm", defaults.block_half_size_mm)),
-            block_height_mm=float(block.get("height_mm", defaults.block_height_mm)),
-            E_roller_MPa=float(roller.get("E_MPa", defaults.E_roller_MPa)),
-            nu_roller=float(roller.get("nu", defaults.nu_roller)),
-            E_block_MPa=float(block.get("E_MPa", defaults.E_block_MPa)),
-            nu_block=float(block.get("nu", defaults.nu_block)),
-            symmetry=str(mesh.get("symmetry", defaults.symmetry)),
-            grid_margin=float(mesh.get("grid_margin", defaults.grid_margin)),
+            roller_half_length_mm=float(r.value(roller, "half_length_mm")),
+            block_half_size_mm=float(b.value(block, "half_size_mm")),
+            block_height_mm=float(b.value(block, "height_mm")),
+            E_roller_MPa=float(r.value(roller, "E_MPa")),
+            nu_roller=float(r.value(roller, "nu")),
+            E_block_MPa=float(b.value(block, "E_MPa")),
+            nu_block=float(b.value(block, "nu")),
+            symmetry=str(m.value(mesh, "symmetry")),
+            grid_margin=float(m.value(mesh, "grid_margin")),
         )
     except InputError as exc:
         if exc.field not in _SCENE_KEYS:
             raise
         raise InputError(_SCENE_KEYS[exc.field], exc.value, exc.allowed) from exc
-    nlev = len(CELLS_ACROSS_MINOR)
-    level = mesh.get("level", 3)
-    if not 0 <= level < nlev:
-        raise InputError("mesh.level", level, f"an integer in [0, {nlev - 1}]")
-    backend = sections["solver"].get("backend", "auto")
-    if backend not in ("auto", "pardiso", "superlu"):
-        raise InputError("solver.backend", backend, "'auto', 'pardiso' or 'superlu'")
-    fidelity = sections["solver"].get("fidelity", "fe")
-    if fidelity not in ("fe", "hybrid"):
-        raise InputError("solver.fidelity", fidelity, "'fe' or 'hybrid'")
-    fe_level = sections["solver"].get("fe_level", 0)
-    if not 0 <= fe_level < nlev:
-        raise InputError("solver.fe_level", fe_level, f"an integer in [0, {nlev - 1}]")
-    levels = sections["study"].get("levels", [])
-    for i, lv in enumerate(levels):
-        if not (isinstance(lv, int) and not isinstance(lv, bool) and 0 <= lv < nlev):
-            raise InputError(f"study.levels[{i}]", lv, f"an integer in [0, {nlev - 1}]")
+    solver, study = _SECTION["solver"], _SECTION["study"]
+    level = m.value(mesh, "level")
+    backend = solver.value(sections["solver"], "backend")
+    fidelity = solver.value(sections["solver"], "fidelity")
+    fe_level = solver.value(sections["solver"], "fe_level")
+    levels = study.value(sections["study"], "levels")
     return HertzCase(
         name=sections["case"].get("name", Path(source).stem),
         scene=scene,
@@ -308,3 +342,31 @@ def load_case(path: str | Path) -> HertzCase | GearCase:
     except UnicodeDecodeError as exc:
         raise InputError("case", str(p), "a UTF-8 text file", str(exc)) from exc
     return parse_case(data, source=str(p))
+
+
+def reference() -> str:
+    """The case-file reference of every kind (Markdown), from the schema declarations: the
+    content of ``docs/case_files.md`` (``python -m fegear.case > docs/case_files.md``)."""
+    from fegear.io import gear_case
+
+    return "\n".join(
+        [
+            "# Case files",
+            "",
+            "Generated from the schema declarations by `python -m fegear.case > "
+            "docs/case_files.md` (a test keeps it equal). `*` = required. Units are in the key "
+            "names. Unknown sections and keys are refused with the closest known one suggested; "
+            "every error names the field, the value and what is allowed.",
+            "",
+            "## Gear pairs",
+            "",
+            gear_case.reference(),
+            '## Hertz scene (`kind = "hertz_scene"`)',
+            "",
+            reference_markdown(SECTIONS),
+        ]
+    )
+
+
+if __name__ == "__main__":
+    print(reference(), end="")

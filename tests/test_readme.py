@@ -160,8 +160,19 @@ def test_case_file_reference_is_the_schema():
     from fegear.io import gear_case as gc
 
     rows = _case_table()
-    expected = {f"`[{s}]`": set(keys) for s, keys in gc._COMMON_SCHEMA.items()}
-    for kind, keys in gc._PAIR_SCHEMA.items():
-        expected[f"`[pair]`, kind `{kind}`"] = set(keys)
-    expected["`[errors]`"] = set(gc._ERRORS_INTERSECTING) | set(gc._ERRORS_PARALLEL)
+    expected = {
+        f"`[{sec.name}]`": set(sec.names) for sec in (gc.CASE, gc.LOAD, gc.ANALYSIS, gc.MATERIAL)
+    }
+    for kind, sec in gc.PAIR_SECTIONS.items():
+        expected[f"`[pair]`, kind `{kind}`"] = set(sec.names)
+    expected["`[errors]`"] = set(gc.PAIR_ERRORS_INTERSECTING) | set(gc.PAIR_ERRORS_PARALLEL)
     assert rows == expected
+
+
+def test_the_case_file_reference_page_is_generated_from_the_schema():
+    """docs/case_files.md is what ``python -m fegear.case`` writes from the declarations (the
+    validator reads the same declarations, so the page cannot drift from what is accepted)."""
+    from fegear.case import reference
+
+    page = (REPO / "docs" / "case_files.md").read_text(encoding="utf-8")
+    assert page == reference(), "regenerate: python -m fegear.case > docs/case_files.md"

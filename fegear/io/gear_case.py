@@ -6,32 +6,11 @@ required keys are refused, and every error is an :class:`~fegear.errors.InputErr
 case-file field, the value and the allowed range, so that ``fegear run`` prints one line and exits
 with code 2 before any work.
 
-Schema (``*`` = required)::
-
-    [case]      kind* = "face_gear" | "spur" | "spiral_bevel", name, description
-    [pair]      design data, by kind (below)
-    [load]      torque2_Nm | torque2_Nmm | pinion_torque_Nm   (exactly one, > 0)
-                speed_rpm (recorded only: the model is quasi-static, speed does not enter)
-    [errors]    intersecting axes (face_gear, spiral_bevel): dE_mm, dA1_mm, dA2_mm, dgamma_deg
-                parallel axes (spur): da_mm, f_sigma_delta_mm, f_sigma_beta_mm, dA1_mm, dA2_mm
-                (all default 0; sign conventions in :mod:`fegear.assembly`)
-    [analysis]  fidelity ("hybrid" default | "fe" | "hertz" | "tca"), level (0..4), n_positions,
-                n_teeth (3..9; default: the teeth that can touch + one neighbour each side),
-                backend ("auto" | "pardiso" | "superlu")
-    [material]  E_MPa (> 0), nu (in (-1, 0.5))    — both members
-
-``[pair]`` by kind:
-
-- ``face_gear``: n_face_gear*, n_pinion*, module_mm*, pressure_angle_deg*, inner_radius_mm*,
-  outer_radius_mm*, shaft_angle_deg, pinion_face_width_mm, blank_thickness_mm, n_shaper
-  (default n_pinion + 2), addendum_coeff, dedendum_coeff.
-- ``spur``: teeth* = [z1, z2], module_mm*, pressure_angle_deg*, profile_shift = [x1, x2],
-  face_width_mm (a number or [b1, b2]), addendum_coeff, dedendum_coeff, profile_crowning_mm,
-  lead_crowning_mm, tip_relief_mm (a number for both members or [pinion, gear]).
-- ``spiral_bevel`` (blank data; machine settings are synthesized): n_pinion*, n_gear*,
-  module_mm* (outer transverse), spiral_angle_deg*, pressure_angle_deg*, face_width_mm*,
-  shaft_angle_deg, cutter_radius_mm, te_amplitude_arcsec (predesigned parabolic TE), side
-  ("drive" | "coast").
+The schema is declared once, as :class:`~fegear.io.schema.Section` objects (:func:`sections`):
+the validation, the defaults and the case-file reference (:func:`reference`,
+``docs/case_files.md``) all come from it. Sections: ``[case]`` (kind, name), ``[pair]`` (design
+data, by kind), ``[load]`` (one torque), ``[errors]`` (installation errors, by axis arrangement),
+``[analysis]`` (fidelity, level, positions, sector teeth, backend), ``[material]``.
 
 The load is the resisting torque on member 2 or the torque on member 1, positive in the driving
 sense; a pinion torque is converted with the tooth ratio, ``T2 = T1 · N2/N1`` (no friction).
@@ -41,13 +20,29 @@ from __future__ import annotations
 
 import copy
 import difflib
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from fegear.assembly import InstallationErrors
 from fegear.errors import InputError
+from fegear.geometry.face_gear import FaceGearDesign
+from fegear.geometry.involute import InvoluteDesign
+from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
+from fegear.io.schema import (
+    INT_PAIR,
+    INTEGER,
+    NUMBER,
+    NUMBER_OR_PAIR,
+    NUMBER_PAIR,
+    STRING,
+    Key,
+    Range,
+    Section,
+    check_document,
+    check_table,
+    reference_markdown,
+)
 
 __all__ = [
     "GEAR_KINDS",
@@ -60,6 +55,8 @@ __all__ = [
     "build_pair",
     "assemble",
     "error_fields",
+    "reference",
+    "sections",
 ]
 
 GEAR_KINDS = ("face_gear", "spur", "spiral_bevel")
@@ -73,73 +70,361 @@ DEFAULT_FIDELITY = "hybrid"
 #: Sector mesh levels 0 … N_LEVELS − 1 (:data:`fegear.mesh.sector.FINE`).
 N_LEVELS = 5
 
-_NUM = (int, float)
-_PAIR = "number-or-pair"  # a number (both members) or a list [pinion, gear]
-_INT2 = "int-pair"  # a list of two integers
-_NUM2 = "number-pair"  # a list of two numbers
-
-# schema: key -> (type, required)
-_PAIR_SCHEMA: dict[str, dict[str, tuple[Any, bool]]] = {
-    "face_gear": {
-        "n_face_gear": (int, True),
-        "n_pinion": (int, True),
-        "module_mm": (_NUM, True),
-        "pressure_angle_deg": (_NUM, True),
-        "inner_radius_mm": (_NUM, True),
-        "outer_radius_mm": (_NUM, True),
-        "shaft_angle_deg": (_NUM, False),
-        "pinion_face_width_mm": (_NUM, False),
-        "blank_thickness_mm": (_NUM, False),
-        "n_shaper": (int, False),
-        "addendum_coeff": (_NUM, False),
-        "dedendum_coeff": (_NUM, False),
-    },
-    "spur": {
-        "teeth": (_INT2, True),
-        "module_mm": (_NUM, True),
-        "pressure_angle_deg": (_NUM, True),
-        "profile_shift": (_NUM2, False),
-        "face_width_mm": (_PAIR, False),
-        "addendum_coeff": (_PAIR, False),
-        "dedendum_coeff": (_PAIR, False),
-        "profile_crowning_mm": (_PAIR, False),
-        "lead_crowning_mm": (_PAIR, False),
-        "tip_relief_mm": (_PAIR, False),
-    },
-    "spiral_bevel": {
-        "n_pinion": (int, True),
-        "n_gear": (int, True),
-        "module_mm": (_NUM, True),
-        "spiral_angle_deg": (_NUM, True),
-        "pressure_angle_deg": (_NUM, True),
-        "face_width_mm": (_NUM, True),
-        "shaft_angle_deg": (_NUM, False),
-        "cutter_radius_mm": (_NUM, False),
-        "te_amplitude_arcsec": (_NUM, False),
-        "side": (str, False),
-    },
-}
-_ERRORS_INTERSECTING = ("dE_mm", "dA1_mm", "dA2_mm", "dgamma_deg")
-_ERRORS_PARALLEL = ("da_mm", "f_sigma_delta_mm", "f_sigma_beta_mm", "dA1_mm", "dA2_mm")
-_COMMON_SCHEMA: dict[str, dict[str, tuple[Any, bool]]] = {
-    "case": {"kind": (str, True), "name": (str, False), "description": (str, False)},
-    "load": {
-        "torque2_Nm": (_NUM, False),
-        "torque2_Nmm": (_NUM, False),
-        "pinion_torque_Nm": (_NUM, False),
-        "speed_rpm": (_NUM, False),
-    },
-    "analysis": {
-        "fidelity": (str, False),
-        "level": (int, False),
-        "n_positions": (int, False),
-        "n_teeth": (int, False),
-        "backend": (str, False),
-    },
-    "material": {"E_MPa": (_NUM, False), "nu": (_NUM, False)},
-}
-_REQUIRED_SECTIONS = ("case", "pair", "load")
+_FIDELITY_NOTE = "fe, hertz, hybrid (loaded) or tca (unloaded)"
+_TORQUE_ALLOWED = "> 0 (positive in the driving sense)"
 _TORQUE_KEYS = ("torque2_Nm", "torque2_Nmm", "pinion_torque_Nm")
+
+
+def _design_default(cls: type, name: str) -> Any:
+    """The default of a design dataclass field (the geometry owns it; the reference shows it)."""
+    return cls.__dataclass_fields__[name].default  # type: ignore[attr-defined]
+
+
+_POS = Range(0, None, lo_open=True)
+_NONNEG = Range(0, None)
+_TEETH = Range(5, None)
+_DEG = "deg"
+
+#: ``[pair]`` by kind (design data; the geometry checks the rest: undercut, pointing).
+PAIR_SECTIONS: dict[str, Section] = {
+    "face_gear": Section(
+        "pair",
+        (
+            Key("n_face_gear", INTEGER, "teeth of the face gear", True, range=_TEETH),
+            Key("n_pinion", INTEGER, "teeth of the spur involute pinion", True, range=_TEETH),
+            Key("module_mm", NUMBER, "module, mm", True, range=_POS),
+            Key(
+                "pressure_angle_deg",
+                NUMBER,
+                "pressure angle, deg",
+                True,
+                range=Range(10, 35, unit=_DEG),
+            ),
+            Key("inner_radius_mm", NUMBER, "radius of the tooth's inner end, mm", True, range=_POS),
+            Key(
+                "outer_radius_mm",
+                NUMBER,
+                "radius of the tooth's outer end (> inner), mm",
+                True,
+                range=_POS,
+            ),
+            Key(
+                "shaft_angle_deg",
+                NUMBER,
+                "shaft angle, deg",
+                default=_design_default(FaceGearDesign, "shaft_angle_deg"),
+                range=Range(45, 135, unit=_DEG),
+            ),
+            Key(
+                "pinion_face_width_mm",
+                NUMBER,
+                "pinion face width, mm",
+                default=_design_default(FaceGearDesign, "pinion_face_width_mm"),
+                range=_POS,
+            ),
+            Key(
+                "blank_thickness_mm",
+                NUMBER,
+                "face-gear blank below the root, mm",
+                default=_design_default(FaceGearDesign, "blank_thickness_mm"),
+                range=_POS,
+            ),
+            Key(
+                "n_shaper",
+                INTEGER,
+                "teeth of the shaper that generates the face gear (default: n_pinion + 2)",
+                range=_TEETH,
+            ),
+            Key(
+                "addendum_coeff",
+                NUMBER,
+                "addendum / module",
+                default=_design_default(FaceGearDesign, "addendum_coeff"),
+                range=_POS,
+            ),
+            Key(
+                "dedendum_coeff",
+                NUMBER,
+                "dedendum / module",
+                default=_design_default(FaceGearDesign, "dedendum_coeff"),
+                range=_POS,
+            ),
+        ),
+        "Face gear with a spur involute pinion, generated by a shaper.",
+        required=True,
+    ),
+    "spur": Section(
+        "pair",
+        (
+            Key("teeth", INT_PAIR, "tooth numbers", True, range=_TEETH),
+            Key("module_mm", NUMBER, "normal module, mm", True, range=_POS),
+            Key(
+                "pressure_angle_deg",
+                NUMBER,
+                "pressure angle, deg",
+                True,
+                range=Range(10, 35, unit=_DEG),
+            ),
+            Key(
+                "profile_shift",
+                NUMBER_PAIR,
+                "profile shift coefficients",
+                default=[0.0, 0.0],
+                range=Range(-1, 2),
+            ),
+            Key(
+                "face_width_mm",
+                NUMBER_OR_PAIR,
+                "face width, mm",
+                default=_design_default(InvoluteDesign, "face_width_mm"),
+                range=_POS,
+            ),
+            Key(
+                "addendum_coeff",
+                NUMBER_OR_PAIR,
+                "addendum / module",
+                default=_design_default(InvoluteDesign, "addendum_coeff"),
+                range=_POS,
+            ),
+            Key(
+                "dedendum_coeff",
+                NUMBER_OR_PAIR,
+                "dedendum / module",
+                default=_design_default(InvoluteDesign, "dedendum_coeff"),
+                range=_POS,
+            ),
+            Key(
+                "profile_crowning_mm",
+                NUMBER_OR_PAIR,
+                "profile crowning, mm",
+                default=_design_default(InvoluteDesign, "profile_crowning_mm"),
+                range=_NONNEG,
+            ),
+            Key(
+                "lead_crowning_mm",
+                NUMBER_OR_PAIR,
+                "lead crowning, mm",
+                default=_design_default(InvoluteDesign, "lead_crowning_mm"),
+                range=_NONNEG,
+            ),
+            Key(
+                "tip_relief_mm",
+                NUMBER_OR_PAIR,
+                "tip relief, mm",
+                default=_design_default(InvoluteDesign, "tip_relief_mm"),
+                range=_NONNEG,
+            ),
+        ),
+        "Spur involute pair (validation): a number for both members or [pinion, gear].",
+        required=True,
+    ),
+    "spiral_bevel": Section(
+        "pair",
+        (
+            Key("n_pinion", INTEGER, "pinion teeth (member 1, <= n_gear)", True, range=_TEETH),
+            Key("n_gear", INTEGER, "gear teeth", True, range=_TEETH),
+            Key("module_mm", NUMBER, "outer transverse module, mm", True, range=_POS),
+            Key(
+                "spiral_angle_deg",
+                NUMBER,
+                "mean spiral angle, deg",
+                True,
+                range=Range(0, 50, unit=_DEG),
+            ),
+            Key(
+                "pressure_angle_deg",
+                NUMBER,
+                "pressure angle, deg",
+                True,
+                range=Range(10, 30, unit=_DEG),
+            ),
+            Key("face_width_mm", NUMBER, "face width, mm", True, range=_POS),
+            Key(
+                "shaft_angle_deg",
+                NUMBER,
+                "shaft angle, deg",
+                default=_design_default(SpiralBevelBlank, "shaft_angle_deg"),
+                range=Range(0, 180, lo_open=True, hi_open=True, unit=_DEG),
+            ),
+            Key(
+                "cutter_radius_mm",
+                NUMBER,
+                "gear head-cutter radius, mm",
+                default=_design_default(SpiralBevelBlank, "cutter_radius_mm"),
+                range=_POS,
+            ),
+            Key(
+                "edge_radius_mm",
+                NUMBER,
+                "blade edge radius (generates the fillet), mm "
+                "(default: 0.25 m where the tooth spaces carry it, else 80 % of the largest "
+                "they carry)",
+                range=_POS,
+            ),
+            Key(
+                "te_amplitude_arcsec",
+                NUMBER,
+                "predesigned parabolic TE amplitude, arcsec",
+                default=_design_default(SynthesisTargets, "te_amplitude_arcsec"),
+                range=Range(0, 60, lo_open=True, unit="arcsec"),
+            ),
+            Key(
+                "side",
+                STRING,
+                "the flank pair that drives",
+                default="drive",
+                choices=("drive", "coast"),
+            ),
+        ),
+        "Spiral bevel blank data (face-milled): the machine settings are synthesized.",
+        required=True,
+    ),
+}
+_INTERSECTING = "intersecting axes (face gear, spiral bevel)"
+_PARALLEL = "parallel axes (spur)"
+#: ``[errors]`` by axis arrangement (sign conventions: :mod:`fegear.assembly`).
+ERROR_KEYS: dict[str, tuple[Key, ...]] = {
+    "intersecting": (
+        Key(
+            "dE_mm", NUMBER, f"{_INTERSECTING}: shortest distance between the axes, mm", default=0.0
+        ),
+        Key("dA1_mm", NUMBER, f"{_INTERSECTING}: pinion axial (ΔP), mm", default=0.0),
+        Key("dA2_mm", NUMBER, f"{_INTERSECTING}: gear axial (ΔG, Δq), mm", default=0.0),
+        Key("dgamma_deg", NUMBER, f"{_INTERSECTING}: shaft angle, deg", default=0.0),
+    ),
+    "parallel": (
+        Key("da_mm", NUMBER, f"{_PARALLEL}: centre distance, mm", default=0.0),
+        Key(
+            "f_sigma_delta_mm",
+            NUMBER,
+            f"{_PARALLEL}: axis inclination in the plane of the axes over the face width, mm",
+            default=0.0,
+        ),
+        Key(
+            "f_sigma_beta_mm",
+            NUMBER,
+            f"{_PARALLEL}: axis deviation out of that plane over the face width, mm",
+            default=0.0,
+        ),
+        Key("dA1_mm", NUMBER, f"{_PARALLEL}: pinion axial, mm", default=0.0),
+        Key("dA2_mm", NUMBER, f"{_PARALLEL}: gear axial, mm", default=0.0),
+    ),
+}
+PAIR_ERRORS_INTERSECTING = tuple(k.name for k in ERROR_KEYS["intersecting"])
+PAIR_ERRORS_PARALLEL = tuple(k.name for k in ERROR_KEYS["parallel"])
+#: The sections every gear case has (``[pair]`` and ``[errors]`` depend on the kind).
+CASE = Section(
+    "case",
+    (
+        Key("kind", STRING, "the gear family", True, choices=GEAR_KINDS),
+        Key("name", STRING, "case name (default: the file name)"),
+        Key("description", STRING, "free text", default=""),
+    ),
+    required=True,
+)
+LOAD = Section(
+    "load",
+    (
+        Key(
+            "torque2_Nm",
+            NUMBER,
+            "resisting torque on member 2, N·m",
+            range=_POS,
+            allowed=_TORQUE_ALLOWED,
+        ),
+        Key(
+            "torque2_Nmm",
+            NUMBER,
+            "resisting torque on member 2, N·mm",
+            range=_POS,
+            allowed=_TORQUE_ALLOWED,
+        ),
+        Key(
+            "pinion_torque_Nm",
+            NUMBER,
+            "torque on member 1, N·m (T2 = T1 N2/N1)",
+            range=_POS,
+            allowed=_TORQUE_ALLOWED,
+        ),
+        Key("speed_rpm", NUMBER, "recorded only (the model is quasi-static)", range=_NONNEG),
+    ),
+    "Exactly one torque, positive in the driving sense.",
+    required=True,
+)
+ANALYSIS = Section(
+    "analysis",
+    (
+        Key(
+            "fidelity",
+            STRING,
+            "contact model: hybrid, hertz, fe (loaded) or tca (unloaded)",
+            default=DEFAULT_FIDELITY,
+            choices=FIDELITIES,
+            allowed=f"one of {FIDELITIES} for gear pairs",
+            hint=_FIDELITY_NOTE,
+        ),
+        Key(
+            "level",
+            INTEGER,
+            "sector mesh level (0 coarse)",
+            default=0,
+            range=Range(0, N_LEVELS - 1),
+        ),
+        Key("n_positions", INTEGER, "positions per mesh cycle", default=25, range=Range(2, 400)),
+        Key(
+            "n_teeth",
+            INTEGER,
+            "teeth per sector (default: the teeth that can touch + one each side)",
+            range=Range(3, 9),
+            allowed="an integer in [3, 9], or absent (automatic)",
+        ),
+        Key(
+            "backend",
+            STRING,
+            "sparse direct solver",
+            default="auto",
+            choices=("auto", "pardiso", "superlu"),
+        ),
+    ),
+)
+MATERIAL = Section(
+    "material",
+    (
+        Key("E_MPa", NUMBER, "Young's modulus of both members, MPa", default=206000.0, range=_POS),
+        Key(
+            "nu",
+            NUMBER,
+            "Poisson's ratio of both members",
+            default=0.3,
+            range=Range(-1, 0.5, lo_open=True, hi_open=True),
+        ),
+    ),
+)
+
+
+def sections(kind: str) -> tuple[Section, ...]:
+    """The sections of a gear case of ``kind`` (``[pair]`` and ``[errors]`` by kind)."""
+    errors = Section(
+        "errors",
+        ERROR_KEYS["parallel" if kind == "spur" else "intersecting"],
+        "Installation errors, all 0 by default (sign conventions: fegear.assembly).",
+    )
+    return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL)
+
+
+def reference() -> str:
+    """The gear case-file reference (Markdown), from the declarations."""
+    common = (CASE, LOAD, ANALYSIS, MATERIAL)
+    errors = tuple(
+        Section("errors", keys, f"Installation errors, {what}; all 0 by default.")
+        for keys, what in ((ERROR_KEYS["intersecting"], _INTERSECTING),
+                           (ERROR_KEYS["parallel"], _PARALLEL))
+    )  # fmt: skip
+    parts = [reference_markdown(common, "Every gear case")]
+    for kind, sec in PAIR_SECTIONS.items():
+        parts.append(reference_markdown((sec,), f'`kind = "{kind}"`'))
+    parts.append(reference_markdown(errors, "Installation errors"))
+    return "\n".join(parts)
 
 
 @dataclass(frozen=True)
@@ -377,143 +662,22 @@ def _tooth_numbers(kind: str, pair: dict[str, Any]) -> tuple[int, int]:
 
 
 def _error_keys(kind: str) -> tuple[str, ...]:
-    return _ERRORS_PARALLEL if kind == "spur" else _ERRORS_INTERSECTING
-
-
-def _is_num(v: Any) -> bool:
-    return isinstance(v, _NUM) and not isinstance(v, bool)
-
-
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
-def _check_value(fld: str, value: Any, typ: Any) -> None:
-    if typ is _NUM:
-        if not _is_num(value):
-            raise InputError(fld, value, "a number")
-        if not math.isfinite(value):
-            raise InputError(fld, value, "a finite number")
-    elif typ is int:
-        if not _is_int(value):
-            raise InputError(fld, value, "an integer")
-    elif typ is str:
-        if not isinstance(value, str):
-            raise InputError(fld, value, "a string")
-    elif typ in (_INT2, _NUM2, _PAIR):
-        if typ == _PAIR and _is_num(value):
-            _check_value(fld, value, _NUM)
-            return
-        what = {
-            _INT2: "a list of two integers [pinion, gear]",
-            _NUM2: "a list of two numbers [pinion, gear]",
-            _PAIR: "a number or a list of two numbers [pinion, gear]",
-        }[typ]
-        if not isinstance(value, list) or len(value) != 2:
-            raise InputError(fld, value, what)
-        for i, v in enumerate(value):
-            _check_value(f"{fld}[{i}]", v, int if typ == _INT2 else _NUM)
-
-
-def _check_table(
-    section: str, table: Any, schema: dict[str, tuple[Any, bool]], what: str = ""
-) -> dict[str, Any]:
-    if not isinstance(table, dict):
-        raise InputError(section, table, f"a TOML table [{section}]")
-    for key, value in table.items():
-        if key not in schema:
-            close = difflib.get_close_matches(key, list(schema), n=1, cutoff=0.5)
-            hint = f"did you mean {close[0]!r}?" if close else ""
-            raise InputError(
-                f"{section}.{key}", value, f"one of the keys {sorted(schema)}{what}", hint
-            )
-        _check_value(f"{section}.{key}", value, schema[key][0])
-    for key, (_, required) in schema.items():
-        if required and key not in table:
-            raise InputError(f"{section}.{key}", "missing", f"present (required{what})")
-    return dict(table)
-
-
-def _positive(fld: str, v: float) -> None:
-    if not v > 0:
-        raise InputError(fld, v, "> 0")
-
-
-def _in_range(fld: str, v: float, lo: float, hi: float, unit: str = "") -> None:
-    if not lo <= v <= hi:
-        raise InputError(fld, v, f"in [{lo:g}, {hi:g}]{unit}")
-
-
-def _teeth(fld: str, v: int, minimum: int = 5) -> None:
-    if v < minimum:
-        raise InputError(fld, v, f"an integer >= {minimum}")
+    return PAIR_ERRORS_PARALLEL if kind == "spur" else PAIR_ERRORS_INTERSECTING
 
 
 def _check_pair(kind: str, p: dict[str, Any]) -> dict[str, Any]:
-    """Plain ranges of the design data (the geometry checks the rest: undercut, pointing)."""
-    if kind == "face_gear":
-        for k in ("n_face_gear", "n_pinion", "n_shaper"):
-            if k in p:
-                _teeth(f"pair.{k}", p[k])
-        for k in ("module_mm", "inner_radius_mm", "outer_radius_mm", "pinion_face_width_mm",
-                  "blank_thickness_mm", "addendum_coeff", "dedendum_coeff"):  # fmt: skip
-            if k in p:
-                _positive(f"pair.{k}", p[k])
-        _in_range("pair.pressure_angle_deg", p["pressure_angle_deg"], 10, 35, " deg")
-        if "shaft_angle_deg" in p:
-            _in_range("pair.shaft_angle_deg", p["shaft_angle_deg"], 45, 135, " deg")
-        if p["outer_radius_mm"] <= p["inner_radius_mm"]:
-            raise InputError(
-                "pair.outer_radius_mm",
-                p["outer_radius_mm"],
-                f"> pair.inner_radius_mm = {p['inner_radius_mm']}",
-            )
-    elif kind == "spur":
-        for i, z in enumerate(p["teeth"]):
-            _teeth(f"pair.teeth[{i}]", z)
-        _positive("pair.module_mm", p["module_mm"])
-        _in_range("pair.pressure_angle_deg", p["pressure_angle_deg"], 10, 35, " deg")
-        for i, x in enumerate(p.get("profile_shift", [0.0, 0.0])):
-            _in_range(f"pair.profile_shift[{i}]", x, -1, 2)
-        for k, check in (
-            ("face_width_mm", _positive),
-            ("addendum_coeff", _positive),
-            ("dedendum_coeff", _positive),
-        ):
-            for fld, v in _members(k, p.get(k)):
-                check(fld, v)
-        for k in ("profile_crowning_mm", "lead_crowning_mm", "tip_relief_mm"):
-            for fld, v in _members(k, p.get(k)):
-                if v < 0:
-                    raise InputError(fld, v, ">= 0")
-    else:
-        _teeth("pair.n_pinion", p["n_pinion"])
-        _teeth("pair.n_gear", p["n_gear"])
-        if p["n_pinion"] > p["n_gear"]:
-            raise InputError(
-                "pair.n_pinion", p["n_pinion"], f"<= pair.n_gear = {p['n_gear']} (member 1)"
-            )
-        for k in ("module_mm", "face_width_mm", "cutter_radius_mm", "te_amplitude_arcsec"):
-            if k in p:
-                _positive(f"pair.{k}", p[k])
-        _in_range("pair.spiral_angle_deg", p["spiral_angle_deg"], 0, 50, " deg")
-        _in_range("pair.pressure_angle_deg", p["pressure_angle_deg"], 10, 30, " deg")
-        if "shaft_angle_deg" in p and not 0 < p["shaft_angle_deg"] < 180:
-            raise InputError("pair.shaft_angle_deg", p["shaft_angle_deg"], "in (0, 180) deg")
-        if "te_amplitude_arcsec" in p:
-            _in_range("pair.te_amplitude_arcsec", p["te_amplitude_arcsec"], 0, 60, " arcsec")
-        if p.get("side", "drive") not in ("drive", "coast"):
-            raise InputError("pair.side", p["side"], "'drive' or 'coast'")
+    """The rules between ``[pair]`` keys (each key's own range is in its declaration)."""
+    if kind == "face_gear" and p["outer_radius_mm"] <= p["inner_radius_mm"]:
+        raise InputError(
+            "pair.outer_radius_mm",
+            p["outer_radius_mm"],
+            f"> pair.inner_radius_mm = {p['inner_radius_mm']}",
+        )
+    if kind == "spiral_bevel" and p["n_pinion"] > p["n_gear"]:
+        raise InputError(
+            "pair.n_pinion", p["n_pinion"], f"<= pair.n_gear = {p['n_gear']} (member 1)"
+        )
     return p
-
-
-def _members(key: str, value: Any) -> list[tuple[str, float]]:
-    """``[(field, value)]`` of a number-or-pair key (empty if absent)."""
-    if value is None:
-        return []
-    if isinstance(value, list):
-        return [(f"pair.{key}[{i}]", v) for i, v in enumerate(value)]
-    return [(f"pair.{key}", value)]
 
 
 def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
@@ -536,27 +700,15 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     kind = data["case"].get("kind") if isinstance(data["case"], dict) else None
     if kind not in GEAR_KINDS:
         raise InputError("case.kind", kind, f"one of {GEAR_KINDS}")
-    sections = ("case", "pair", "load", "errors", "analysis", "material")
-    for key in data:
-        if key not in sections:
-            close = difflib.get_close_matches(key, list(sections), n=1, cutoff=0.5)
-            raise InputError(
-                key,
-                "[" + key + "]",
-                f"one of the sections {sorted(sections)}",
-                f"did you mean [{close[0]}]?" if close else "",
-            )
-    for sec in _REQUIRED_SECTIONS:
-        if sec not in data:
-            raise InputError(sec, "missing", f"a [{sec}] section (required)")
+    case_s, pair_s, load_s, errors_s, analysis_s, material_s = sections(kind)
+    check_document(data, sections(kind))
     for_kind = f" for kind {kind!r}"
-    case = _check_table("case", data["case"], _COMMON_SCHEMA["case"])
-    pair = _check_pair(kind, _check_table("pair", data["pair"], _PAIR_SCHEMA[kind], for_kind))
-    load = _check_table("load", data["load"], _COMMON_SCHEMA["load"])
-    err_schema = {k: (_NUM, False) for k in _error_keys(kind)}
-    errs = _check_table("errors", data.get("errors", {}), err_schema, for_kind)
-    ana = _check_table("analysis", data.get("analysis", {}), _COMMON_SCHEMA["analysis"])
-    mat = _check_table("material", data.get("material", {}), _COMMON_SCHEMA["material"])
+    case = check_table(case_s, data["case"])
+    pair = _check_pair(kind, check_table(pair_s, data["pair"], for_kind))
+    load = check_table(load_s, data["load"])
+    errs = check_table(errors_s, data.get("errors", {}), for_kind)
+    ana = check_table(analysis_s, data.get("analysis", {}))
+    mat = check_table(material_s, data.get("material", {}))
 
     given = [k for k in _TORQUE_KEYS if k in load]
     if len(given) != 1:
@@ -567,39 +719,19 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         )
     key = given[0]
     value = float(load[key])
-    if not value > 0:
-        raise InputError(f"load.{key}", load[key], "> 0 (positive in the driving sense)")
     n1, n2 = _tooth_numbers(kind, pair)
     torque2 = {
         "torque2_Nm": value * 1000.0,
         "torque2_Nmm": value,
         "pinion_torque_Nm": value * 1000.0 * n2 / n1,
     }[key]
-    if "speed_rpm" in load and load["speed_rpm"] < 0:
-        raise InputError("load.speed_rpm", load["speed_rpm"], ">= 0")
-
-    fidelity = ana.get("fidelity", DEFAULT_FIDELITY)
-    if fidelity not in FIDELITIES:
-        raise InputError(
-            "analysis.fidelity", fidelity, f"one of {FIDELITIES} for gear pairs", _FIDELITY_NOTE
-        )
-    level = ana.get("level", 0)
-    if not 0 <= level < N_LEVELS:
-        raise InputError("analysis.level", level, f"an integer in [0, {N_LEVELS - 1}]")
-    n_pos = ana.get("n_positions", 25)
-    if not 2 <= n_pos <= 400:
-        raise InputError("analysis.n_positions", n_pos, "an integer in [2, 400]")
-    n_teeth = ana.get("n_teeth")
-    if n_teeth is not None and not 3 <= n_teeth <= 9:
-        raise InputError("analysis.n_teeth", n_teeth, "an integer in [3, 9], or absent (automatic)")
-    backend = ana.get("backend", "auto")
-    if backend not in ("auto", "pardiso", "superlu"):
-        raise InputError("analysis.backend", backend, "'auto', 'pardiso' or 'superlu'")
-    E = float(mat.get("E_MPa", 206000.0))
-    _positive("material.E_MPa", E)
-    nu = float(mat.get("nu", 0.3))
-    if not -1.0 < nu < 0.5:
-        raise InputError("material.nu", nu, "in (-1, 0.5)")
+    fidelity = analysis_s.value(ana, "fidelity")
+    level = analysis_s.value(ana, "level")
+    n_pos = analysis_s.value(ana, "n_positions")
+    n_teeth = analysis_s.value(ana, "n_teeth")
+    backend = analysis_s.value(ana, "backend")
+    E = float(material_s.value(mat, "E_MPa"))
+    nu = float(material_s.value(mat, "nu"))
     try:
         errors = InstallationErrors(**{k: float(v) for k, v in errs.items()})
     except InputError as exc:
@@ -620,12 +752,9 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         E_MPa=E,
         nu=nu,
         speed_rpm=float(load["speed_rpm"]) if "speed_rpm" in load else None,
-        description=case.get("description", ""),
+        description=case_s.value(case, "description"),
         source=source,
     )
-
-
-_FIDELITY_NOTE = "fe, hertz, hybrid (loaded) or tca (unloaded)"
 
 
 # --------------------------------------------------------------------------------------------
@@ -662,7 +791,7 @@ def _renamed(
     f = exc.field.split(".")[-1]
     key = table.get(f, f)
     pair = case.pair
-    if key in _PAIR_SCHEMA[case.kind]:
+    if key in PAIR_SECTIONS[case.kind].names:
         fld = f"pair.{key}"
         if member is not None and isinstance(pair.get(key), list):
             fld += f"[{member}]"
@@ -671,8 +800,10 @@ def _renamed(
     return type(exc)(f"pair ({who} {f}, derived from the [pair] data)", exc.value, exc.allowed)
 
 
-def _member_value(pair: dict, key: str, i: int, default: float) -> float:
-    v = pair.get(key, default)
+def _member_value(pair: dict, key: str, i: int) -> float:
+    """Member ``i``'s value of a number-or-pair ``[pair]`` key of a spur case (its declared
+    default when absent)."""
+    v = PAIR_SECTIONS["spur"].value(pair, key)
     return float(v[i]) if isinstance(v, list) else float(v)
 
 
@@ -709,13 +840,13 @@ def build_pair(case: GearCase) -> GearPair:
                     n_teeth=int(p["teeth"][i]),
                     module_mm=float(p["module_mm"]),
                     pressure_angle_deg=float(p["pressure_angle_deg"]),
-                    profile_shift=float(p.get("profile_shift", [0.0, 0.0])[i]),
-                    face_width_mm=_member_value(p, "face_width_mm", i, 10.0),
-                    addendum_coeff=_member_value(p, "addendum_coeff", i, 1.0),
-                    dedendum_coeff=_member_value(p, "dedendum_coeff", i, 1.25),
-                    profile_crowning_mm=_member_value(p, "profile_crowning_mm", i, 0.0),
-                    lead_crowning_mm=_member_value(p, "lead_crowning_mm", i, 0.0),
-                    tip_relief_mm=_member_value(p, "tip_relief_mm", i, 0.0),
+                    profile_shift=_member_value(p, "profile_shift", i),
+                    face_width_mm=_member_value(p, "face_width_mm", i),
+                    addendum_coeff=_member_value(p, "addendum_coeff", i),
+                    dedendum_coeff=_member_value(p, "dedendum_coeff", i),
+                    profile_crowning_mm=_member_value(p, "profile_crowning_mm", i),
+                    lead_crowning_mm=_member_value(p, "lead_crowning_mm", i),
+                    tip_relief_mm=_member_value(p, "tip_relief_mm", i),
                 )
                 members.append(InvoluteMember(d, name))
             except InputError as exc:
@@ -732,7 +863,7 @@ def build_pair(case: GearCase) -> GearPair:
         "pressure_angle_deg": float(p["pressure_angle_deg"]),
         "face_width_mm": float(p["face_width_mm"]),
     }
-    for k in ("shaft_angle_deg", "cutter_radius_mm"):
+    for k in ("shaft_angle_deg", "cutter_radius_mm", "edge_radius_mm"):
         if k in p:
             blank_kw[k] = float(p[k])
     target_kw = {}
@@ -745,7 +876,7 @@ def build_pair(case: GearCase) -> GearPair:
         sb = _BEVEL_CACHE[key]
     except InputError as exc:
         raise _renamed(exc, None, _BEVEL_FIELDS, case) from exc
-    side = p.get("side", "drive")
+    side = PAIR_SECTIONS["spiral_bevel"].value(p, "side")
     return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
 
 
