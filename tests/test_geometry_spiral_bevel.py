@@ -467,3 +467,18 @@ def test_default_edge_radius_and_its_effect():
         SpiralBevelPair.design(SpiralBevelBlank(edge_radius_mm=1.5), targets=tg)
     assert e.value.field == "spiral_bevel.edge_radius_mm"
     assert "tooth space" in str(e.value) and "overlap" in str(e.value)
+
+
+def test_the_plain_data_record_rebuilds_the_same_pair(pair):
+    """The synthesis is cached as JSON (no pickle): the pair rebuilt from its record has the same
+    settings and the same flank points, bit for bit (floats survive JSON exactly)."""
+    import json
+
+    rebuilt = SpiralBevelPair.from_record(json.loads(json.dumps(pair.record())))
+    assert rebuilt.settings == pair.settings and rebuilt.blank == pair.blank
+    for name in ("pinion", "gear"):
+        a, b = getattr(pair, name), getattr(rebuilt, name)
+        for side in ("drive", "coast"):
+            fa, fb = a.flank(side, nu=7, nv=5), b.flank(side, nu=7, nv=5)
+            np.testing.assert_array_equal(fa.points, fb.points)
+    np.testing.assert_array_equal(rebuilt.reports["drive"].point, pair.reports["drive"].point)

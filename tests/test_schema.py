@@ -106,9 +106,22 @@ def test_the_defaults_are_the_cases_values():
     assert (case.E_MPa, case.nu) == (206000.0, 0.3)
 
 
-def test_the_bevel_edge_radius_reaches_the_synthesis():
-    """``pair.edge_radius_mm`` is not only accepted: the cutters of the synthesized pair carry it
-    (the blank's edge radius is what generates the fillet)."""
+def test_the_bevel_edge_radius_reaches_the_synthesis(monkeypatch):
+    """``pair.edge_radius_mm`` is not only accepted: it is part of the blank the synthesis gets
+    (the blank's edge radius is what generates the fillet; the synthesis itself, 10-20 s, is
+    replaced by a recorder here)."""
+    seen = {}
+
+    def record(blank_kw, target_kw):
+        seen.update(blank_kw)
+        raise RuntimeError("recorded")
+
+    monkeypatch.setattr(gc, "_bevel_pair", record)
     doc = {**SEED_BEVEL, "pair": {**SEED_BEVEL["pair"], "edge_radius_mm": 0.6}}
-    pair = gc.build_pair(parse_case(doc))
-    assert pair.spiral_bevel.blank.edge_radius == 0.6
+    with pytest.raises(RuntimeError, match="recorded"):
+        gc.build_pair(parse_case(doc))
+    assert seen["edge_radius_mm"] == 0.6
+    seen.clear()
+    with pytest.raises(RuntimeError, match="recorded"):
+        gc.build_pair(parse_case(SEED_BEVEL))
+    assert "edge_radius_mm" not in seen  # absent: the synthesis chooses it

@@ -55,7 +55,8 @@ from __future__ import annotations
 import functools
 import logging
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -593,6 +594,46 @@ class SpiralBevelPair:
         )
         return cls(blank, targets, settings, reports, pinion, gear)
 
+    def record(self) -> dict[str, Any]:
+        """The pair as plain data (JSON-ready: numbers, strings, lists): blank, targets, machine
+        settings and synthesis reports. :meth:`from_record` rebuilds the same pair (the members
+        are built from the settings; floats survive JSON exactly), so a synthesis can be cached
+        without pickling code objects."""
+        return {
+            "format": _RECORD_FORMAT,
+            "blank": _plain_fields(self.blank),
+            "targets": _plain_fields(self.targets),
+            "settings": {
+                k: _plain_fields(getattr(self.settings, k))
+                for k in ("gear_drive", "gear_coast", "pinion_drive", "pinion_coast")
+            },
+            "reports": {side: _plain_fields(r) for side, r in self.reports.items()},
+        }
+
+    @classmethod
+    def from_record(cls, rec: dict[str, Any]) -> SpiralBevelPair:
+        """The pair of a :meth:`record`.
+
+        Raises
+        ------
+        InputError
+            A record of another format.
+        """
+        if rec.get("format") != _RECORD_FORMAT:
+            raise InputError("spiral_bevel record format", rec.get("format"), _RECORD_FORMAT)
+        blank = SpiralBevelBlank(**rec["blank"])
+        targets = SynthesisTargets(**rec["targets"])
+        settings = SpiralBevelSettings(
+            **{k: MachineSettings(**v) for k, v in rec["settings"].items()}
+        )
+        reports = {
+            side: SynthesisReport(
+                **{k: np.asarray(v, float) if isinstance(v, list) else v for k, v in r.items()}
+            )
+            for side, r in rec["reports"].items()
+        }
+        return cls._build(blank, targets, settings, reports)
+
     def mesh_placement(self, side: Side):
         """``(pinion(φ1), gear(φ2))``: functions of driving-sense angles (rad) → 4×4 member → mesh.
 
@@ -605,6 +646,23 @@ class SpiralBevelPair:
             self.blank, side, r.gear_flank_angle, r.pinion_flank_angle, r.sigma
         )
         return pin, gear
+
+
+_RECORD_FORMAT = "fegear.spiral_bevel_pair/1"
+
+
+def _plain_fields(obj: Any) -> dict[str, Any]:
+    """A frozen dataclass of numbers, strings and arrays as a JSON-ready dict (arrays → lists,
+    numpy scalars → Python numbers)."""
+    out = {}
+    for f in fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray):
+            v = v.tolist()
+        elif isinstance(v, np.generic):
+            v = v.item()
+        out[f.name] = v
+    return out
 
 
 def _with_edge_radius(settings: SpiralBevelSettings, rho: float) -> SpiralBevelSettings:

@@ -882,11 +882,12 @@ def build_pair(case: GearCase) -> GearPair:
 
 def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
     """The synthesized spiral bevel pair of the blank data: read from the artefact cache when
-    the same blank and targets were synthesized before by the same geometry code (the
-    synthesis takes 10-20 s; its pickle loads in a millisecond), else synthesized and cached.
-    The key holds a hash of the source of the geometry and TCA packages
-    (:func:`fegear.tca.cached._source_hash`): a change of the synthesis invalidates it."""
-    import pickle
+    the same blank and targets were synthesized before by the same geometry code (the synthesis
+    takes 10-20 s), else synthesized and cached. The entry is the pair's plain-data record
+    (:meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.record`, JSON: no pickle); the key
+    holds a hash of the source of the geometry and TCA packages
+    (:func:`fegear.tca.cached._source_hash`), so a change of the synthesis invalidates it."""
+    import json
 
     from fegear.geometry.spiral_bevel import SpiralBevelPair
     from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
@@ -900,13 +901,13 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
         box["pair"] = SpiralBevelPair.design(
             SpiralBevelBlank(**blank_kw), SynthesisTargets(**target_kw)
         )
-        path.write_bytes(pickle.dumps(box["pair"], protocol=pickle.HIGHEST_PROTOCOL))
+        path.write_text(json.dumps(box["pair"].record()), encoding="utf-8")
 
     params = {"blank": blank_kw, "targets": target_kw, "source": _source_hash()}
-    path, hit = cached_file("bevel_pair", params, ".pkl", build)
+    path, hit = cached_file("bevel_pair", params, ".json", build)
     if not hit:
         return box["pair"]
-    return pickle.loads(path.read_bytes())
+    return SpiralBevelPair.from_record(json.loads(path.read_text(encoding="utf-8")))
 
 
 def error_fields(case: GearCase) -> list[tuple[str, float]]:
