@@ -1,0 +1,192 @@
+"""Write ``docs/validation.md``: fegear against references computed without the solver.
+
+Usage::
+
+    python docs/make_validation.py [hertz] [fzg] [bevel] [trend] [root]   # default: all
+    python docs/make_validation.py render      # rewrite the page from docs/validation.json
+
+Runs the cases (:mod:`fegear.validation.rows`): the Hertz scene at ``fe`` and ``hybrid`` levels
+0-5, the FZG pair at its pitch point (``hybrid`` 0-2, ``fe`` 0-3, ``hertz`` 0), the spiral bevel's
+unloaded TCA, the seed face gear at its three loads (``hybrid`` and ``hertz`` level 0), and the
+ISO 6336-3 root-stress rows of ``fegear.validation.iso6336_root.rows()`` when that exists. It takes
+tens of minutes on 2 cores with an empty cache (the page states the time it took). The rows are
+kept in ``docs/validation.json``: naming sections reruns only those and keeps the others' rows.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import sys
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+from fegear.validation import Row, as_row
+from fegear.validation import rows as V
+
+HERE = Path(__file__).resolve().parent
+PAGE = HERE / "validation.md"
+DATA = HERE / "validation.json"
+SECTIONS = ("hertz", "fzg", "bevel", "trend", "root")
+#: (fidelity, level) of the FZG pitch-point runs.
+FZG_RUNS = (("hybrid", 0), ("hybrid", 1), ("hybrid", 2), ("fe", 0), ("fe", 1), ("fe", 2),
+            ("fe", 3), ("hertz", 0))  # fmt: skip
+#: (fidelity, level) of the seed face-gear load trend (``fe`` level 0 cannot resolve the patch:
+#: every position degenerate, docs/ltca/te_vs_load.md).
+TREND_RUNS = (("hybrid", 0), ("hertz", 0))
+
+log = logging.getLogger("make_validation")
+
+
+def measure(section: str) -> list[Row]:
+    """Run one section's cases; its rows."""
+    if section == "hertz":
+        return V.hertz_scene_rows()
+    if section == "fzg":
+        runs = []
+        for fid, lv in FZG_RUNS:
+            r = V.pitch_point_run(fid, lv)
+            log.warning("fzg %s %d: c' %.2f, p_mid %.1f MPa (%.0f s)", fid, lv, r.c_prime,
+                        r.p_mid_MPa, r.seconds)  # fmt: skip
+            runs.append(r)
+        return V.fzg_rows(runs)
+    if section == "bevel":
+        return V.bevel_rows(V.bevel_te_parabola())
+    if section == "trend":
+        trends = {}
+        for fid, lv in TREND_RUNS:
+            trends[(fid, lv)] = V.load_trend(fid, lv)
+            log.warning("trend %s %d: %s", fid, lv, trends[(fid, lv)])
+        return V.load_trend_rows(trends)
+    if section == "root":
+        return V.root_stress_rows() or [V.pending_root_stress_row()]
+    raise SystemExit(f"unknown section {section!r}: one of {', '.join(SECTIONS)}")
+
+
+def _num(x: float | None, ref: float | None = None) -> str:
+    if x is None or not math.isfinite(x):
+        return "—"
+    mag = abs(ref if ref is not None else x)
+    if mag >= 1000:
+        return f"{x:.1f}"
+    if mag >= 10:
+        return f"{x:.2f}"
+    return f"{x:.4g}" if mag < 0.1 else f"{x:.3f}"
+
+
+def _level(v) -> str:
+    return "—" if v.level is None else str(v.level)
+
+
+def table(rows: list[Row]) -> str:
+    """The summary table: one line per fegear value."""
+    out = [
+        "| check | quantity | reference | fidelity | level | fegear | ratio | command |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if r.pending:
+            out.append(f"| {r.check} | {r.quantity} | {r.reference_text} | — | — | "
+                       f"{r.pending} | — | `{r.command}` |")  # fmt: skip
+            continue
+        ref = "rises with load" if r.reference is None else _num(r.reference)
+        for i, v in enumerate(r.values):
+            check, quantity, ref_i, cmd = (
+                (r.check, r.quantity, ref, f"`{r.command}`") if i == 0 else ("", "", "", "")
+            )
+            if r.loads:
+                val = " → ".join(_num(x) for x in v.series)
+                up = r.increasing(v)
+                s = v.series
+                grow = (s[-1] / s[0]) if up is not None and s[0] else None
+                ratio = ("—" if up is None else
+                         f"×{grow:.2f} {'increasing' if up else 'NOT increasing'}")  # fmt: skip
+            else:
+                val = _num(v.value, r.reference)
+                q = r.ratio(v)
+                ratio = "—" if q is None else f"{q:.3f}"
+            out.append(f"| {check} | {quantity} | {ref_i} | `{v.fidelity}` | {_level(v)} | "
+                       f"{val} | {ratio} | {cmd} |")  # fmt: skip
+    return "\n".join(out)
+
+
+def details(rows: list[Row]) -> str:
+    """Per row: the reference, the tolerance and test, and each value's notes."""
+    out = []
+    for r in rows:
+        out += [f"### {r.check}", "", f"- quantity: {r.quantity}"]
+        out.append(f"- reference: {r.reference_text}"
+                   + ("" if r.reference is None else f" → **{_num(r.reference)}**"))  # fmt: skip
+        if r.loads:
+            out.append(f"- loads: {', '.join(r.loads)}")
+        out.append(f"- test: `{r.test}`, tolerance {r.tolerance}")
+        out.append(f"- command: `{r.command}`")
+        if r.pending:
+            out.append(f"- **{r.pending}**")
+        for v in r.values:
+            t = "" if v.seconds is None else f", {v.seconds:.1f} s"
+            note = f": {v.note}" if v.note else ""
+            out.append(f"- `{v.fidelity}` level {_level(v)}{t}{note}")
+        out.append("")
+    return "\n".join(out)
+
+
+def write(rows: list[Row], seconds: float, sections: tuple[str, ...]) -> None:
+    head = f"""# Validation
+
+Each row sets a fegear result against a reference computed without the solver: a closed form, a
+standard (ISO 6336), or the design target the geometry was synthesized for. The references are in
+`fegear/validation/iso6336.py` and `fegear/hertz.py`, the measurements in
+`fegear/validation/rows.py`; each row is a test in `tests/test_validation.py` (the slow ones
+under `-m slow`) with its tolerance and the reason for it.
+
+This page is generated: `python docs/make_validation.py` runs every case below and rewrites it
+(this run: {seconds / 60:.1f} min for the sections {", ".join(sections)}, 2 cores; a section
+named on the command line is rerun alone, the other rows are kept from `docs/validation.json`).
+Ratio = fegear / reference; a trend row gives its values at the three loads and how much the
+quantity grew.
+
+## Summary
+
+"""
+    PAGE.write_text(
+        head + table(rows) + "\n\n## Rows\n\n" + details(rows).rstrip() + "\n", encoding="utf-8"
+    )
+
+
+def main(argv: list[str]) -> None:
+    logging.basicConfig(level=logging.WARNING, format="%(message)s")
+    if argv == ["render"]:  # rewrite the page from docs/validation.json, no runs
+        doc = json.loads(DATA.read_text(encoding="utf-8"))
+        rows = [as_row(d) for s in SECTIONS for d in doc["sections"].get(s, [])]
+        write(rows, doc["seconds"], tuple(doc["ran"]))
+        print(PAGE)
+        return
+    sections = tuple(argv) or SECTIONS
+    for s in sections:
+        if s not in SECTIONS:
+            raise SystemExit(f"unknown section {s!r}: one of {', '.join(SECTIONS)}")
+    old: dict[str, list[dict]] = {}
+    if DATA.exists() and set(sections) != set(SECTIONS):
+        old = json.loads(DATA.read_text(encoding="utf-8"))["sections"]
+    t0 = time.perf_counter()
+    new: dict[str, list[dict]] = {}
+    for s in SECTIONS:
+        if s in sections:
+            t = time.perf_counter()
+            new[s] = [asdict(r) for r in measure(s)]
+            log.warning("%s: %.0f s", s, time.perf_counter() - t)
+        elif s in old:
+            new[s] = old[s]
+    seconds = time.perf_counter() - t0
+    doc = {"sections": new, "seconds": seconds, "ran": list(sections)}
+    DATA.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+    rows = [as_row(d) for s in SECTIONS for d in new.get(s, [])]
+    write(rows, seconds, sections)
+    print(PAGE)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
