@@ -36,9 +36,11 @@ from __future__ import annotations
 import logging
 import time
 import weakref
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -47,12 +49,13 @@ from scipy.spatial import cKDTree
 
 from fegear.errors import InputError, SolverError
 from fegear.fem.elasticity import ElasticBody
-from fegear.linalg import inverse_columns, requested_backend, resolve_backend
+from fegear.linalg import inverse_columns, inverse_off_block, requested_backend, resolve_backend
 from fegear.mesh.cache import cached_file
 
 __all__ = [
     "SurfacePoints",
     "CandidateOperator",
+    "OperatorBlock",
     "locate_on_boundary",
     "load_operator",
     "candidate_operator",
@@ -81,18 +84,38 @@ class SurfacePoints:
     distance: np.ndarray
 
 
+class OperatorBlock(NamedTuple):
+    """One dense block ``G[rows][:, cols]`` of a :class:`CandidateOperator`.
+
+    Attributes
+    ----------
+    rows
+        (r,) sorted positions in the operator's ``dofs``.
+    cols
+        (k,) sorted positions in the operator's ``cols``.
+    G
+        (r, k) mm/N, memory-mapped when read from the cache.
+    """
+
+    rows: np.ndarray
+    cols: np.ndarray
+    G: np.ndarray
+
+
 @dataclass(frozen=True)
 class CandidateOperator:
     """``(K^{-1})_{cf}`` of a body: displacements of its candidate DOFs ``c`` under unit forces
-    on its load DOFs ``f ⊂ c``.
+    on its load DOFs ``f ⊂ c``, stored as dense blocks (:class:`OperatorBlock`): one block
+    ``(m, k)``, or, for an operator built in groups (:func:`candidate_operator`), ``G_ff`` and
+    one block ``G_{read_g, load_g}`` per group. Entries in no block are never computed:
+    :meth:`take` gives them as NaN.
 
     Attributes
     ----------
     dofs
         (m,) candidate DOFs ``c`` in the full vector numbering, sorted.
-    G
-        (m, k) mm/N, the dense block of the inverse stiffness (rows ``dofs``, columns ``cols``);
-        square and symmetric when every candidate DOF is a load DOF.
+    blocks
+        The dense blocks; no two hold the same entry.
     cols
         (k,) load DOFs ``f`` (full numbering, sorted, a subset of ``dofs``).
     fixed
@@ -107,12 +130,63 @@ class CandidateOperator:
     """
 
     dofs: np.ndarray
-    G: np.ndarray
+    blocks: tuple[OperatorBlock, ...]
     seconds: float
     cache_hit: bool
     backend: str
     cols: np.ndarray
     fixed: np.ndarray
+
+    @cached_property
+    def _row_map(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(block, index)``, (m,) each: the block holding each row and the row's index in it
+        (-1: in none)."""
+        block = np.full(self.dofs.size, -1, dtype=np.intp)
+        index = np.full(self.dofs.size, -1, dtype=np.intp)
+        for b, blk in enumerate(self.blocks):
+            block[blk.rows] = b
+            index[blk.rows] = np.arange(blk.rows.size)
+        return block, index
+
+    @cached_property
+    def _col_maps(self) -> tuple[np.ndarray, ...]:
+        """Per block, (k,) the index of each column in it (-1: not in it)."""
+        out = []
+        for blk in self.blocks:
+            index = np.full(self.cols.size, -1, dtype=np.intp)
+            index[blk.cols] = np.arange(blk.cols.size)
+            out.append(index)
+        return tuple(out)
+
+    def take(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``G[rows][:, cols]`` (len(rows), len(cols)) mm/N, ``rows`` positions in ``dofs``,
+        ``cols`` positions in ``cols``; NaN where no block holds the entry. Only the entries
+        asked for are read (the blocks may be memory-mapped)."""
+        rows = np.asarray(rows, dtype=np.intp)
+        cols = np.asarray(cols, dtype=np.intp)
+        block, index = self._row_map
+        bid = block[rows]
+        if bid.size and np.all(bid == bid[0]) and bid[0] >= 0:  # one block: no NaN fill
+            cm = self._col_maps[bid[0]][cols]
+            if np.all(cm >= 0):
+                return np.asarray(self.blocks[bid[0]].G[np.ix_(index[rows], cm)])
+        out = np.full((rows.size, cols.size), np.nan)
+        for b in np.unique(bid[bid >= 0]):
+            sel = np.flatnonzero(bid == b)
+            cm = self._col_maps[b][cols]
+            ok = np.flatnonzero(cm >= 0)
+            if ok.size:
+                out[np.ix_(sel, ok)] = self.blocks[b].G[np.ix_(index[rows[sel]], cm[ok])]
+        return out
+
+    @property
+    def G(self) -> np.ndarray:  # noqa: N802 (the operator is G)
+        """(m, k) mm/N, the whole block ``(K^{-1})_{cf}`` (rows ``dofs``, columns ``cols``), NaN
+        where no block holds the entry; materialised in memory on each call (for checks: a
+        position reads its entries with :meth:`take`)."""
+        if len(self.blocks) == 1 and self.blocks[0].G.shape == (self.dofs.size, self.cols.size):
+            return self.blocks[0].G
+        return self.take(np.arange(self.dofs.size), np.arange(self.cols.size))
 
 
 _MEMO: dict[tuple[int, str], tuple[weakref.ref, object]] = {}
@@ -357,40 +431,54 @@ def candidate_operator(
     ``groups`` (``[(load_g, read_g), ...]``, e.g. one per loaded tooth: its flank DOFs and the
     DOFs of the layer below them) says which read-only rows are ever read under which loads: then
     only ``G_ff`` (every load DOF under every load: the coupling of all teeth) and the blocks
-    ``G_{read_g, load_g}`` are computed, each as the inverse of its own Schur complement (for any
-    index set ``J``, ``(K^{-1})_{JJ} = (S_J)^{-1}``, ``S_J`` the Schur complement of ``K`` onto
-    ``J``): ``Σ_g cost(l_g, f_g) + f³`` instead of ``cost(Σ l_g, f)``, the dense work being cubic
-    (:func:`~fegear.linalg.inverse_columns`). The other entries of ``G`` (a layer under one tooth
-    read under the load of another) are NaN: never used, and loud if they were. Measured on the
-    seed face gear's level-0 sector (3 loaded teeth, f = 6246, l = 10 902): 31.7 s against
-    127.9 s for the whole block (2 cores, with another process running).
+    ``G_{read_g, load_g}`` are computed and stored, ``G_ff`` as the inverse of the Schur
+    complement onto ``f`` and each ``G_{read_g, load_g}`` from the Schur complement onto
+    ``load_g ∪ read_g`` and the block ``G_{load_g, load_g}`` of ``G_ff``
+    (:func:`~fegear.linalg.inverse_off_block`): ``Σ_g cost(l_g, f_g) + f³`` instead of
+    ``cost(Σ l_g, f)``, the dense work being cubic. The other entries of ``G`` (a layer under one
+    tooth read under the load of another) are never computed (NaN in
+    :meth:`CandidateOperator.take`). Measured on the seed face gear's level-0 sector (3 loaded
+    teeth, f = 6246, l = 10 902): 31.7 s against 127.9 s for the whole block (2 cores, with
+    another process running). Stored as the blocks, one after the other in one file
+    (:func:`_write_blocks`), not as a ``(m, k)`` array mostly NaN: 498 MB instead of 857 MB there.
     """
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     f = c if load_dofs is None else np.intersect1d(np.asarray(load_dofs, np.int64), body.free)
     if not np.all(np.isin(f, c)):
         raise InputError("load_dofs", f"{int(np.sum(~np.isin(f, c)))} outside dofs", "within dofs")
-    blocks = None if groups is None else _groups(c, f, body.free, groups)
+    groups_ = None if groups is None else _groups(c, f, body.free, groups)
     pos = np.searchsorted(body.free, c)
+    rf = np.searchsorted(c, f)
+    if groups_ is None:
+        layout = [(np.arange(c.size), np.arange(f.size))]
+    else:
+        layout = [(rf, np.arange(f.size))]
+        layout += [(np.searchsorted(c, lg), np.searchsorted(f, fg)) for fg, lg in groups_]
     t0 = time.perf_counter()
     requested_backend(backend)  # a bad name is refused on a cache hit too
     used = ""
 
-    def compute() -> np.ndarray:
+    def compute() -> Iterator[np.ndarray]:
+        """The blocks of ``layout``, in order."""
         nonlocal used
         used = resolve_backend(backend)  # only when computing: loading MKL takes 0.3 s
-        if blocks is None:
-            return inverse_columns(body.K, pos, np.isin(c, f), backend=used)
-        G = np.full((c.size, f.size), np.nan)
-        rf = np.searchsorted(c, f)
-        G[rf] = inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=used)
-        for fg, lg in blocks:
+        if groups_ is None:
+            yield inverse_columns(body.K, pos, np.isin(c, f), backend=used)
+            return
+        G_ff = inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=used)
+        yield G_ff
+        for (fg, lg), (_, cols_g) in zip(groups_, layout[1:], strict=True):
             cg = np.union1d(fg, lg)
-            Gg = inverse_columns(body.K, np.searchsorted(body.free, cg), np.isin(cg, fg), used)
-            G[np.ix_(np.searchsorted(c, lg), np.searchsorted(f, fg))] = Gg[np.isin(cg, lg)]
-        return G
+            yield inverse_off_block(
+                body.K,
+                np.searchsorted(body.free, cg),
+                np.isin(cg, fg),
+                G_ff[np.ix_(cols_g, cols_g)],
+                used,
+            )
 
     if cache_key is None:
-        G = compute()
+        arrays = list(compute())
         hit = False
     else:
         params = {
@@ -403,16 +491,27 @@ def candidate_operator(
         }
         if f.size < c.size:
             params.update(kind="inverse_columns_v1", cols=f)
-        if blocks is not None:
-            params.update(kind="inverse_group_blocks_v1", groups=[g for b in blocks for g in b])
+        if groups_ is not None:
+            # v2: the blocks one after the other (v1 held the whole (m, k) array)
+            params.update(kind="inverse_group_blocks_v2", groups=[g for b in groups_ for g in b])
 
         def build(path: Path) -> None:
-            with open(path, "wb") as fh:
-                np.save(fh, compute())
+            if groups_ is None:
+                with open(path, "wb") as fh:
+                    np.save(fh, next(compute()))
+            else:
+                _write_blocks(path, [(r.size, k.size) for r, k in layout], compute())
 
         path, hit = cached_file("compliance", params, ".npy", build)
         # Memory-mapped: a position reads only the rows and columns its cells touch.
-        G = np.load(path, mmap_mode="r")
+        stored = np.load(path, mmap_mode="r")
+        if groups_ is None:
+            arrays = [stored]
+        else:
+            arrays, at = [], 0
+            for r, k in layout:
+                arrays.append(stored[at : at + r.size * k.size].reshape(r.size, k.size))
+                at += r.size * k.size
     dt = time.perf_counter() - t0
     log.info(
         "candidate operator: %d DOFs, %d load DOFs in %.2f s (%s)",
@@ -422,15 +521,31 @@ def candidate_operator(
         "cache" if hit else used,
     )
     fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
+    blocks = tuple(OperatorBlock(r, k, G) for (r, k), G in zip(layout, arrays, strict=True))
     return CandidateOperator(
         dofs=c,
-        G=G,
+        blocks=blocks,
         seconds=dt,
         cache_hit=hit,
         backend="cache" if hit else used,
         cols=f,
         fixed=fixed,
     )
+
+
+def _write_blocks(path: Path, shapes: list[tuple[int, int]], blocks: Iterator[np.ndarray]) -> None:
+    """Write the blocks of ``shapes`` (each ``(r, k)`` float64, as ``blocks`` yields them, one in
+    memory at a time) one after the other, row-major, as one 1-D ``.npy`` array (memory-mapped
+    back by :func:`candidate_operator`)."""
+    total = sum(r * k for r, k in shapes)
+    header = {"descr": np.lib.format.dtype_to_descr(np.dtype(np.float64)),
+              "fortran_order": False, "shape": (total,)}  # fmt: skip
+    with open(path, "wb") as fh:
+        np.lib.format.write_array_header_1_0(fh, header)
+        for (r, k), G in zip(shapes, blocks, strict=True):
+            if G.shape != (r, k):
+                raise SolverError(f"operator block of shape {G.shape}, expected {(r, k)}")
+            fh.write(memoryview(np.ascontiguousarray(G, dtype=np.float64)).cast("B"))
 
 
 def _groups(c, f, free, groups) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -501,6 +616,6 @@ def cross_compliance(
     Ps = sp.csr_matrix(P)[op.cols[rp], :]
     # Sparse times dense (a column of P or Q has 30-120 entries): measured 2.7x faster than
     # densifying them for a BLAS product at the sizes of a contact zone (500 x 700 rows).
-    X = Ps.T @ np.asarray(op.G[np.ix_(rq, rp)]).T  # (n_cells, n_rq)
+    X = Ps.T @ op.take(rq, rp).T  # (n_cells, n_rq)
     C = np.asarray(Qs.T @ X.T)
     return 0.5 * (C + C.T) if symmetric else C

@@ -187,13 +187,14 @@ class MklPardiso:
         )
         return int(error.value)
 
-    def spd_inverse(self, S: np.ndarray) -> np.ndarray:
+    def spd_inverse(self, S: np.ndarray, overwrite: bool = False) -> np.ndarray:
         """Inverse of a dense SPD matrix by MKL LAPACK: ``dpotrf`` (``S = Uᵀ U``) then ``dpotri``
         (``S⁻¹ = U⁻¹ U⁻ᵀ``), in place on a row-major copy; the upper triangle is mirrored.
 
         Used instead of SciPy's LAPACK because the OpenBLAS 0.3.30 of the SciPy wheels
         segfaults in multi-threaded ``potrf`` above about 16 000 unknowns (measured: n = 16 384
-        and 17 079 crash with two threads, run with one).
+        and 17 079 crash with two threads, run with one). ``overwrite``: a C-contiguous float64
+        ``S`` is the workspace (and the result), saving a copy of ``n²`` values.
 
         Raises
         ------
@@ -201,7 +202,7 @@ class MklPardiso:
             ``S`` is not numerically positive definite, or LAPACK reports an error.
         """
         n = S.shape[0]
-        a = np.array(S, dtype=np.float64, order="C", copy=True)
+        a = _workspace(S, overwrite)
         # The C array read column-major is Sᵀ = S: factor its lower triangle in LAPACK's own
         # layout (LAPACKE's row-major path would transpose the whole matrix twice).
         self._lapacke_spd("LAPACKE_dpotrf", b"L", a)
@@ -227,10 +228,10 @@ class MklPardiso:
         if info != 0:
             raise SolverError(f"MKL {name} failed: info = {info}")
 
-    def spd_cholesky(self, S: np.ndarray) -> np.ndarray:
+    def spd_cholesky(self, S: np.ndarray, overwrite: bool = False) -> np.ndarray:
         """Lower Cholesky factor ``L`` (``S = L Lᵀ``) of a dense SPD matrix by MKL ``dpotrf``, on
         a row-major copy (for the same reason as :meth:`spd_inverse`); the strict upper triangle
-        is zeroed.
+        is zeroed. ``overwrite``: as :meth:`spd_inverse`.
 
         Raises
         ------
@@ -238,7 +239,7 @@ class MklPardiso:
             ``S`` is not numerically positive definite, or LAPACK reports an error.
         """
         n = S.shape[0]
-        a = np.array(S, dtype=np.float64, order="C", copy=True)
+        a = _workspace(S, overwrite)
         # Column-major upper factor (S = Uᵀ U) of the C array = row-major lower L = Uᵀ.
         self._lapacke_spd("LAPACKE_dpotrf", b"U", a)
         for i0 in range(0, n, 2048):  # zero the strict upper triangle, a block of rows at a time
@@ -320,6 +321,14 @@ class MklPardiso:
             logger.warning("PARDISO memory release (phase -1) returned error %d", rel)
         logger.debug("PARDISO Schur: n=%d m=%d in %.2f s, nnz(L)=%d", n, m, elapsed, int(iparm[17]))
         return x.reshape(m, m)
+
+
+def _workspace(S: np.ndarray, overwrite: bool) -> np.ndarray:
+    """``S`` itself when it may be overwritten and is a C-contiguous float64 array, else a
+    C-contiguous float64 copy."""
+    if overwrite and S.dtype == np.float64 and S.flags.c_contiguous and S.flags.writeable:
+        return S
+    return np.array(S, dtype=np.float64, order="C", copy=True)
 
 
 def load_library() -> MklPardiso:

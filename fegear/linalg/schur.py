@@ -72,6 +72,7 @@ __all__ = [
     "schur_complement",
     "inverse_block",
     "inverse_columns",
+    "inverse_off_block",
 ]
 
 logger = logging.getLogger(__name__)
@@ -364,12 +365,14 @@ def schur_complement(
         S_sorted = _schur_pardiso(Kc, c_sorted, n_threads)
     else:
         S_sorted = _schur_superlu(Kc, c_sorted)
-    # Back from increasing-index order (PARDISO's output order) to the caller's order.
-    rank = np.empty(m, dtype=np.intp)
-    rank[order] = np.arange(m)
-    S = S_sorted[np.ix_(rank, rank)]
-    S = 0.5 * (S + S.T)
-    if not np.all(np.isfinite(S)):
+    # Back from increasing-index order (PARDISO's output order) to the caller's order (no copy
+    # when the caller's order is increasing already: the compliance operators' is).
+    if np.any(order != np.arange(m)):
+        rank = np.empty(m, dtype=np.intp)
+        rank[order] = np.arange(m)
+        S_sorted = S_sorted[np.ix_(rank, rank)]
+    S = _symmetrize(S_sorted)
+    if not _all_finite(S):
         raise SolverError(f"{name}: Schur complement has non-finite entries (K singular?)")
     logger.info(
         "Schur complement with %s: n=%d DOFs onto m=%d in %.2f s",
@@ -379,6 +382,34 @@ def schur_complement(
         time.perf_counter() - t0,
     )
     return S
+
+
+#: Rows per block of the in-place dense passes (a 2048 x 2048 float64 block is 32 MiB).
+_BLOCK_ROWS = 2048
+
+
+def _symmetrize(S: np.ndarray) -> np.ndarray:
+    """``S ← (S + Sᵀ) / 2`` in place, a block pair at a time (no ``m × m`` temporaries): every
+    entry is ``0.5 * (S_ij + S_ji)``, bit for bit what ``0.5 * (S + S.T)`` gives. Returns ``S``."""
+    m = S.shape[0]
+    for i0 in range(0, m, _BLOCK_ROWS):
+        i1 = min(i0 + _BLOCK_ROWS, m)
+        d = S[i0:i1, i0:i1]
+        d[...] = 0.5 * (d + d.T)
+        for j0 in range(i1, m, _BLOCK_ROWS):
+            j1 = min(j0 + _BLOCK_ROWS, m)
+            avg = 0.5 * (S[i0:i1, j0:j1] + S[j0:j1, i0:i1].T)
+            S[i0:i1, j0:j1] = avg
+            S[j0:j1, i0:i1] = avg.T
+    return S
+
+
+def _all_finite(S: np.ndarray) -> bool:
+    """Every entry of ``S`` is finite (checked a block of rows at a time)."""
+    return all(
+        bool(np.isfinite(S[i0 : i0 + _BLOCK_ROWS]).all())
+        for i0 in range(0, S.shape[0], _BLOCK_ROWS)
+    )
 
 
 #: Smallest dense Cholesky / inverse given to MKL when it is at hand (SciPy's OpenBLAS below).
@@ -488,16 +519,16 @@ def inverse_columns(
     if S.size == 0:
         return np.zeros((m, int(cols.sum())))
     if cols.all():
-        return _spd_inverse(S)
+        return _spd_inverse(S, overwrite=True)
     f, l_ = np.flatnonzero(cols), np.flatnonzero(~cols)
     S_lf = S[np.ix_(l_, f)]
     S_ff = S[np.ix_(f, f)]
     S_ll = S[np.ix_(l_, l_)]
     del S
-    L = _spd_cholesky(S_ll)
+    L = _spd_cholesky(S_ll, overwrite=True)
     del S_ll
     W = la.solve_triangular(L, S_lf, lower=True, check_finite=False, overwrite_b=True)
-    G_ff = _spd_inverse(S_ff - W.T @ W)
+    G_ff = _spd_inverse(S_ff - W.T @ W, overwrite=True)
     G_lf = la.solve_triangular(L, W @ G_ff, lower=True, trans="T", check_finite=False)
     G = np.empty((m, f.size))
     G[f] = G_ff
@@ -505,23 +536,94 @@ def inverse_columns(
     return G
 
 
-def _spd_cholesky(S: np.ndarray) -> np.ndarray:
+def inverse_off_block(
+    K: sp.spmatrix | sp.sparray,
+    idx: np.ndarray,
+    columns: np.ndarray,
+    G_ff: np.ndarray,
+    backend: str = "auto",
+    *,
+    n_threads: int | None = None,
+) -> np.ndarray:
+    r"""The rows off ``columns`` of the columns ``columns`` of :math:`(K^{-1})_{cc}`,
+    ``c = idx``, given its square block on ``columns`` (``G_ff``, computed before, e.g. as part of
+    a larger block: :func:`inverse_columns` on more load DOFs).
+
+    With ``f = c[columns]``, ``l = c \setminus f`` and :math:`S` the Schur complement onto ``c``,
+    the rows ``l`` of :math:`S G = I` in the columns ``f`` read
+    :math:`S_{ll} G_{lf} + S_{lf} G_{ff} = 0`, so
+
+    .. math::
+
+        S_{ll} = L L^T,\quad W = L^{-1} S_{lf},\quad G_{lf} = -L^{-T} (W\, G_{ff}),
+
+    :math:`l^3/3 + 2 l^2 f + 2 l f^2` flops: :func:`inverse_columns` without its
+    :math:`f^3 + l f^2` for a :math:`G_{ff}` already known (Golub & Van Loan, *Matrix
+    Computations*, 4th ed., §3.2 and §4.2).
+
+    Parameters
+    ----------
+    K, idx, backend, n_threads
+        As :func:`inverse_block`.
+    columns
+        ``(m,)`` bool, the entries of ``idx`` that are columns (load DOFs), at least one of each.
+    G_ff
+        ``(f, f)`` mm/N, :math:`(K^{-1})_{ff}` (rows and columns in the order of ``idx[columns]``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(l, f)``: :math:`(K^{-1})_{lf}`, rows in the order of ``idx[~columns]``, columns in the
+        order of ``idx[columns]``.
+
+    Raises
+    ------
+    InputError
+        ``columns`` is not a boolean mask of the length of ``idx`` with both values, or ``G_ff``
+        has not the shape ``(f, f)``; and as :func:`inverse_block`.
+    SolverError
+        As :func:`inverse_block`.
+    """
+    cols = np.asarray(columns)
+    if cols.dtype != bool or cols.shape != np.shape(idx) or cols.all() or not cols.any():
+        raise InputError(
+            "columns", f"shape {cols.shape}", f"a bool mask of shape {np.shape(idx)}, mixed"
+        )
+    f, l_ = np.flatnonzero(cols), np.flatnonzero(~cols)
+    if np.shape(G_ff) != (f.size, f.size):
+        raise InputError("G_ff", f"shape {np.shape(G_ff)}", f"({f.size}, {f.size})")
+    S = schur_complement(K, idx, backend, n_threads=n_threads)
+    S_lf = S[np.ix_(l_, f)]
+    S_ll = S[np.ix_(l_, l_)]
+    del S
+    L = _spd_cholesky(S_ll, overwrite=True)
+    del S_ll
+    W = la.solve_triangular(L, S_lf, lower=True, check_finite=False, overwrite_b=True)
+    Y = W @ np.asarray(G_ff)
+    del W
+    Y = la.solve_triangular(L, Y, lower=True, trans="T", check_finite=False, overwrite_b=True)
+    np.negative(Y, out=Y)
+    return Y
+
+
+def _spd_cholesky(S: np.ndarray, overwrite: bool = False) -> np.ndarray:
     """Lower Cholesky factor of a dense SPD matrix (MKL where available, see
-    ``_MKL_DENSE_MIN``)."""
+    ``_MKL_DENSE_MIN``); ``overwrite``: ``S`` may be used as the workspace."""
     lib, _ = _pardiso()
     if lib is not None and S.shape[0] >= _MKL_DENSE_MIN:
-        return lib.spd_cholesky(S)
+        return lib.spd_cholesky(S, overwrite=overwrite)
     try:
-        return la.cholesky(S, lower=True, check_finite=False)
+        return la.cholesky(S, lower=True, check_finite=False, overwrite_a=overwrite)
     except la.LinAlgError as exc:
         raise SolverError(f"Schur complement is not positive definite: {exc}") from exc
 
 
-def _spd_inverse(S: np.ndarray) -> np.ndarray:
-    """Inverse of a dense SPD matrix: LAPACK ``potrf`` + ``potri``, symmetrised exactly."""
+def _spd_inverse(S: np.ndarray, overwrite: bool = False) -> np.ndarray:
+    """Inverse of a dense SPD matrix: LAPACK ``potrf`` + ``potri``, symmetrised exactly;
+    ``overwrite``: ``S`` may be used as the workspace (MKL)."""
     lib, _ = _pardiso()
     if lib is not None and S.shape[0] >= _MKL_DENSE_MIN:  # see _MKL_DENSE_MIN
-        return lib.spd_inverse(S)
+        return lib.spd_inverse(S, overwrite=overwrite)
     try:
         U, lower = la.cho_factor(S, lower=False, check_finite=False)
     except la.LinAlgError as exc:
