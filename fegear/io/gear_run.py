@@ -68,7 +68,12 @@ Progress = Callable[[str, "int | None", "int | None"], None]
 
 @dataclass(frozen=True)
 class MemberField:
-    """One member's sector and its displacement at every position (for the VTK files).
+    """One member's stress sector, its displacement and stress at every position (VTK files,
+    root stress).
+
+    The sector is the contact sector remeshed with the fillets of the zone teeth refined to
+    ``fillet_mm`` (:func:`stress_sector`), loaded by the converged cell forces of the contact
+    solve (:func:`displacements`).
 
     Attributes
     ----------
@@ -87,6 +92,17 @@ class MemberField:
         ``(n_positions, 4, 4)`` member frame → fixed frame at each position.
     solver
         Sparse backend of the displacement solve (``"pypardiso"`` or ``"superlu"``).
+    max_principal, min_principal, von_mises
+        ``(n_positions, n)`` MPa, recovered vertex stresses (:mod:`fegear.fem.stress`: element
+        values at the vertices, averaged); zeros at positions without contact.
+    root
+        Per position, the :class:`~fegear.fem.stress.ToothRootStress` of every tooth that can
+        touch (``loaded`` says whether it carries force there); empty without contact.
+    equilibrium
+        Per position, the :class:`~fegear.fem.stress.Equilibrium` of the solve (None without
+        contact).
+    fillet_mm
+        Element size on the fillets of the stress sector (mm).
     """
 
     name: str
@@ -96,6 +112,27 @@ class MemberField:
     displacement: Array
     placements: Array
     solver: str
+    max_principal: Array | None = None
+    min_principal: Array | None = None
+    von_mises: Array | None = None
+    root: tuple[tuple[Any, ...], ...] = ()
+    equilibrium: tuple[Any, ...] = ()
+    fillet_mm: float | None = None
+
+    @property
+    def root_teeth(self) -> tuple[int, ...]:
+        """Member teeth with a root-stress entry (the teeth that can touch)."""
+        return tuple(sorted({r.tooth for row in self.root for r in row}))
+
+    def root_series(self, tooth: int, what: str = "tension_MPa") -> Array:
+        """``(n_positions,)`` MPa: ``what`` (a :class:`~fegear.fem.stress.ToothRootStress`
+        field) of member tooth ``tooth`` at every position (NaN without contact)."""
+        out = np.full(len(self.root), np.nan)
+        for i, row in enumerate(self.root):
+            for r in row:
+                if r.tooth == tooth:
+                    out[i] = getattr(r, what)
+        return out
 
 
 #: A tip closer than this to the mate's root (mm) is an interference (the clearance is computed
@@ -348,67 +385,175 @@ def _linear_solver(K: sp.csr_matrix) -> tuple[Callable[[Array], Array], str]:
         return lu.solve, "superlu"
 
 
-def displacements(run_pair: GearPair, asm, models, cycle, phi2: Array) -> tuple[MemberField, ...]:
-    """Vertex displacements of both sectors at every position: ``u = K⁻¹ P F``.
+def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
+    """``{member tooth: (q, 3) mm}``: the centres of the loaded contact cells of a position on
+    each tooth of ``member`` (its frame; gear cells moved across their gap onto its flank)."""
+    from fegear.geometry.transforms import apply_points, inverse
 
-    ``P`` is rebuilt exactly as in the contact solve (:func:`fegear.ltca.model.
-    member_load_operator`: pinion cells along ``−n1`` at the pinion flank points, gear cells
-    along ``+n1`` at the points displaced by the cell gap), so the forces are the solver's.
-    The rigid lag ``θ`` of member 2 is not part of ``u`` (the sectors are clamped at the bore
-    and the cuts); the VTK places the gear at its unloaded (TCA-closed) angle.
+    out: dict[int, list[Array]] = {}
+    if not pos.cells:
+        return {}
+    force = pos.solution.force
+    start = 0
+    Minv = inverse(placement)
+    for c in pos.cells:
+        f = force[start : start + c.n]
+        start += c.n
+        if not np.any(f > 0.0):
+            continue
+        x = c.centers[f > 0.0]
+        if member == "gear":
+            x = x + c.gap[f > 0.0, None] * c.normals[f > 0.0]
+        out.setdefault(int(c.k if member == "pinion" else c.j), []).append(apply_points(Minv, x))
+    return {k: np.vstack(v) for k, v in out.items()}
+
+
+def stress_sector(member, model, zone, fillet_mm: float):
+    """The contact sector of ``model`` remeshed with the fillets of its zone teeth at
+    ``fillet_mm`` (:func:`fegear.mesh.sector.sector_mesh`, cached), as a
+    :class:`~fegear.ltca.model.MemberModel` without compliance operator (``op`` None): what
+    :func:`fegear.ltca.model.member_load_operator` needs to load it."""
+    from dataclasses import replace
+
+    from fegear.fem.elasticity import assemble_body
+    from fegear.mesh.sector import sector_mesh
+
+    p = model.sector.parameters
+    sector = sector_mesh(
+        member,
+        int(p["n_teeth"]),
+        int(p["level"]),
+        zone=zone or None,
+        rim_modules=float(p.get("rim_modules", 3.0)),
+        fillet_mm=fillet_mm,
+    )
+    mesh = sector.to_skfem()
+    support = "base" if "base" in mesh.boundaries else "bore"
+    clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
+    body = assemble_body(mesh, model.body.E, model.body.nu, clamped)
+    return replace(model, sector=sector, body=body, op=None, layer_mm=0.0, layer_tets=None)
+
+
+def displacements(
+    run_pair: GearPair, asm, models, cycle, phi2: Array, fillet_modules: float | None = None
+) -> tuple[MemberField, ...]:
+    """Displacement and stress of both stress sectors at every position: ``u = K⁻¹ P F``.
+
+    The sectors are those of the contact solve remeshed with the fillets of the zone teeth at
+    ``fillet_modules`` modules (default :data:`fegear.fem.stress.FILLET_MODULES`,
+    :func:`stress_sector`). ``P`` is built exactly as in the contact solve
+    (:func:`fegear.ltca.model.member_load_operator`: pinion cells along ``−n1`` at the pinion
+    flank points, gear cells along ``+n1`` at the points displaced by the cell gap), so the
+    forces are the solver's. All positions are the columns of one right-hand side (one
+    factorisation per member). The rigid lag ``θ`` of member 2 is not part of ``u`` (the
+    sectors are clamped at the bore and the cuts); the VTK places the gear at its unloaded
+    (TCA-closed) angle. Then, per position, the recovered vertex stresses, the root stress of
+    every tooth that can touch (:func:`fegear.fem.stress.tooth_root_stress`) and the
+    equilibrium of the solve (:func:`fegear.fem.stress.reactions`).
     """
+    from fegear.fem.assembly import elasticity_stiffness
+    from fegear.fem.stress import (
+        CONTACT_CLEARANCE_MODULES,
+        FILLET_MODULES,
+        VertexStress,
+        fillet_regions,
+        principal_stresses,
+        reactions,
+        tooth_root_stress,
+        von_mises,
+    )
     from fegear.ltca.model import member_load_operator
+    from fegear.mesh.sector import FINE
 
     out = []
     n_pos = len(cycle.positions)
-    for name, model in (("pinion", models.pinion), ("gear", models.gear)):
-        body = model.body
+    fm = FILLET_MODULES if fillet_modules is None else float(fillet_modules)
+    zone = models.zone
+    for name, model, member in (
+        ("pinion", models.pinion, run_pair.pinion),
+        ("gear", models.gear, run_pair.gear),
+    ):
+        p = model.sector.parameters
+        module = float(p["h_fine_mm"]) / FINE[int(p["level"])]
+        boxes = None if zone is None else (zone.pinion if name == "pinion" else zone.gear)
+        t0 = time.perf_counter()
+        smodel = stress_sector(member, model, boxes, fm * module)
+        body = smodel.body
         nodal = body.scalar_basis.nodal_dofs[0]  # scalar DOF of each vertex
         vdofs = 3 * nodal[:, None] + np.arange(3)[None, :]
         n_v = body.mesh.p.shape[1]
         place = np.stack(
             [
-                asm.placement1(p.phi1) if name == "pinion" else asm.placement2(phi2[i])
-                for i, p in enumerate(cycle.positions)
+                asm.placement1(pp.phi1) if name == "pinion" else asm.placement2(phi2[i])
+                for i, pp in enumerate(cycle.positions)
             ]
         )
-        B = np.zeros((body.free.size, n_pos))
+        F = np.zeros((body.n_dofs, n_pos))
         for i, pos in enumerate(cycle.positions):
             if not pos.cells:
                 continue
             cols = []
             for c in pos.cells:
                 if name == "pinion":
-                    cols.append(member_load_operator(model, place[i], c.k, c.quad_points,
+                    cols.append(member_load_operator(smodel, place[i], c.k, c.quad_points,
                                                      -c.normals))  # fmt: skip
                 else:
                     q = c.quad_points + c.gap[:, None, None] * c.normals[:, None]
-                    cols.append(member_load_operator(model, place[i], c.j, q, c.normals))
-            f = sp.hstack(cols).tocsr() @ pos.solution.force
-            B[:, i] = f[body.free]
+                    cols.append(member_load_operator(smodel, place[i], c.j, q, c.normals))
+            F[:, i] = sp.hstack(cols).tocsr() @ pos.solution.force
         U = np.zeros((n_pos, n_v, 3))
+        full = np.zeros((body.n_dofs, n_pos))
         used = "none"
-        if np.any(B):
-            t0 = time.perf_counter()
-            solve, used = _linear_solver(body.K)
-            X = solve(B)
-            full = np.zeros((body.n_dofs, n_pos))
-            full[body.free] = X
+        loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
+        K = None
+        if loaded.size:
+            K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
+            solve, used = _linear_solver(K[body.free][:, body.free].tocsr())
+            full[body.free] = np.asarray(solve(np.ascontiguousarray(F[body.free]))).reshape(
+                body.free.size, n_pos
+            )
             U = np.transpose(full[vdofs], (2, 0, 1))
-            log.info("%s: displacements of %d positions in %.2f s (%s)", name, n_pos,
-                     time.perf_counter() - t0, used)  # fmt: skip
+        teeth = model.teeth if model.teeth is not None else None
+        regions = fillet_regions(smodel.sector, model.side, teeth)
+        rec = VertexStress(body.mesh.p.T, body.mesh.t.T, body.scalar_basis.element_dofs,
+                           body.E, body.nu)  # fmt: skip
+        s_max, s_min, s_vm = (np.zeros((n_pos, n_v)) for _ in range(3))
+        root: list[tuple[Any, ...]] = [() for _ in range(n_pos)]
+        equil: list[Any] = [None] * n_pos
+        fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
+        pts = body.mesh.p.T
+        for i in loaded:
+            sig = rec(full[:, i])
+            ps = principal_stresses(sig)
+            s_max[i], s_min[i], s_vm[i] = ps[:, 2], ps[:, 0], von_mises(sig)
+            touch = _loaded_points(cycle.positions[i], name, place[i])
+            root[i] = tuple(
+                tooth_root_stress(pts, r, sig, r.tooth in touch, touch.get(r.tooth),
+                                  CONTACT_CLEARANCE_MODULES * module)
+                for r in regions
+            )  # fmt: skip
+            equil[i] = reactions(K, body.basis.doflocs, fixed, full[:, i], F[:, i])
+        log.info("%s: stress sector (fillets %.3g mm, %d tets), %d positions in %.2f s (%s)",
+                 name, fm * module, body.mesh.t.shape[1], n_pos, time.perf_counter() - t0,
+                 used)  # fmt: skip
         bnames = [b for b in body.mesh.boundaries if b.startswith(f"flank_{model.side}_")]
         facets = np.concatenate([body.mesh.boundaries[b] for b in bnames])
         flank_nodes = np.unique(body.mesh.facets[:, facets])
         out.append(
             MemberField(
                 name=name,
-                points=body.mesh.p.T.copy(),
+                points=pts.copy(),
                 tets=body.mesh.t.T.copy(),
                 flank_nodes=flank_nodes,
                 displacement=U,
                 placements=place,
                 solver=used,
+                max_principal=s_max,
+                min_principal=s_min,
+                von_mises=s_vm,
+                root=tuple(root),
+                equilibrium=tuple(equil),
+                fillet_mm=fm * module,
             )
         )
     return tuple(out)

@@ -49,7 +49,10 @@ MeshAdapt/HXT, Frontal-Delaunay/Delaunay, MeshAdapt/Delaunay, each in a fresh gm
 Sizes: one knob ``level`` (0 coarse … 4 fine). With ``m`` the module, the contact zone gets
 ``h_fine = FINE[level] m``, the fillets of the loaded teeth ``1.25 h_fine``, and the size grows
 linearly with the distance to them (slope 0.4) to ``h_coarse = COARSE[level] m`` (gmsh
-Distance + Threshold fields, Min of both).
+Distance + Threshold fields, Min of both). ``fillet_mm`` sets the size on those fillets
+alone (the root-stress meshes, :mod:`fegear.fem.stress`): the fine layer is then ``2 fillet_mm``
+deep, the distance field samples each fillet face at about ``fillet_mm`` and the size grows
+with the same slope; it enters the cache key only when given, so the contact meshes keep theirs.
 """
 
 from __future__ import annotations
@@ -329,6 +332,7 @@ def _build(
     algorithm: int,
     min_sicn: float,
     path: Path,
+    fillet_mm: float | None = None,
 ) -> dict[str, object]:
     """Build and mesh the sector, writing ``path``; returns the diagnostics.
 
@@ -342,7 +346,7 @@ def _build(
     t0 = time.perf_counter()
     for alg2, alg3 in attempts:
         try:
-            diag = _attempt(fr, n_teeth, level, zone, alg2, alg3, path)
+            diag = _attempt(fr, n_teeth, level, zone, alg2, alg3, path, fillet_mm)
         except _AttemptFailed as exc:
             log.warning("sector mesh: %s", exc)
             failures.append(str(exc))
@@ -369,11 +373,14 @@ def _attempt(
     alg2: int,
     alg3: int,
     path: Path,
+    fillet_mm: float | None = None,
 ) -> dict[str, object]:
     import gmsh
 
     h_fine, h_coarse = mesh_sizes(fr.module, level)
     diag: dict[str, object] = {"h_fine_mm": h_fine, "h_coarse_mm": h_coarse}
+    if fillet_mm is not None:
+        diag["fillet_mm"] = fillet_mm
     t0 = time.perf_counter()
     initialize_gmsh()
     try:
@@ -466,15 +473,26 @@ def _attempt(
         fd.setNumber(t1, "DistMin", 0.5 * h_fine)
         fd.setNumber(t1, "DistMax", 0.5 * h_fine + 2.5 * (h_coarse - h_fine))
         fillets = sorted({t for z in zone for t in groups[f"fillet_{z.tooth}"]})
+        h_fil, d_fil, sampling = 1.25 * h_fine, 0.5 * h_fine, 40
+        if fillet_mm is not None:
+            # samples about one fillet size apart on the largest fillet face, a fine layer two
+            # elements deep (the stress decays over the fillet radius), the same 0.4 slope
+            span = max(
+                float(np.linalg.norm(np.subtract(*np.reshape(
+                    gmsh.model.getBoundingBox(2, t), (2, 3)))))
+                for t in fillets
+            )  # fmt: skip
+            h_fil, d_fil = fillet_mm, 2.0 * fillet_mm
+            sampling = max(40, math.ceil(span / fillet_mm))
         f2 = fd.add("Distance")
         fd.setNumbers(f2, "SurfacesList", fillets)
-        fd.setNumber(f2, "Sampling", 40)
+        fd.setNumber(f2, "Sampling", sampling)
         t2 = fd.add("Threshold")
         fd.setNumber(t2, "InField", f2)
-        fd.setNumber(t2, "SizeMin", 1.25 * h_fine)
+        fd.setNumber(t2, "SizeMin", h_fil)
         fd.setNumber(t2, "SizeMax", h_coarse)
-        fd.setNumber(t2, "DistMin", 0.5 * h_fine)
-        fd.setNumber(t2, "DistMax", 0.5 * h_fine + 2.5 * (h_coarse - 1.25 * h_fine))
+        fd.setNumber(t2, "DistMin", d_fil)
+        fd.setNumber(t2, "DistMax", d_fil + 2.5 * (h_coarse - h_fil))
         fmin = fd.add("Min")
         fd.setNumbers(fmin, "FieldsList", [t1, t2])
         fd.setAsBackgroundMesh(fmin)
@@ -483,7 +501,7 @@ def _attempt(
             "Mesh.MeshSizeFromPoints": 0,
             "Mesh.MeshSizeFromCurvature": 0,
             "Mesh.MeshSizeMax": h_coarse,
-            "Mesh.MeshSizeMin": 0.5 * h_fine,
+            "Mesh.MeshSizeMin": min(0.5 * h_fine, h_fil),
             "Mesh.ElementOrder": 1,
             "Mesh.Optimize": 1,
         }.items():
@@ -585,6 +603,7 @@ def sector_mesh(
     rim_modules: float = 3.0,
     algorithm: int = 10,
     min_sicn: float = 0.03,
+    fillet_mm: float | None = None,
 ) -> SectorMesh:
     """Mesh (or load from the cache) a sector of ``n_teeth`` teeth of ``member``.
 
@@ -605,6 +624,10 @@ def sector_mesh(
         gmsh 3-D algorithm (10 HXT; 1 Delaunay is the automatic fallback).
     min_sicn
         Minimum acceptable element quality (signed inverse condition number).
+    fillet_mm
+        Element size (mm) on the fillets of the zone teeth; None: ``1.25 h_fine``. The root
+        stress is read there (:mod:`fegear.fem.stress`; its convergence under this size:
+        ``benchmarks/results/root_stress_refinement.md``).
 
     Raises
     ------
@@ -630,11 +653,15 @@ def sector_mesh(
         "algorithm": algorithm,
         "min_sicn": min_sicn,
     }
+    if fillet_mm is not None:  # only when given: the contact meshes keep their cache keys
+        if not (np.isfinite(fillet_mm) and fillet_mm > 0.0):
+            raise InputError("mesh.fillet_mm", fillet_mm, "a finite size > 0 (mm)")
+        params["fillet_mm"] = float(fillet_mm)
     side_path = cache_dir("mesh") / f"{content_hash(params)}.json"
     diag_box: dict[str, object] = {}
 
     def build(tmp: Path) -> None:
-        diag_box.update(_build(fr, n_teeth, level, zone, algorithm, min_sicn, tmp))
+        diag_box.update(_build(fr, n_teeth, level, zone, algorithm, min_sicn, tmp, fillet_mm))
         side_path.write_text(json.dumps(diag_box, indent=1))
 
     path, hit = cached_file("mesh", params, ".msh", build)
