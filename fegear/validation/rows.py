@@ -524,6 +524,17 @@ TREND_CASES = (
 )
 
 
+#: How to read a fidelity's trend (docs/ltca/te_vs_load.md).
+TREND_NOTES = {
+    "hybrid": "resolves the 0.5 mm wide patch at level 0",
+    "hertz": (
+        "one closed-form Hertz law per pair on a lumped compliance: it misses the entering "
+        "pair's corner contact at the face-gear tip that shapes the hybrid TE, so its TE "
+        "peak-to-peak levels off (docs/ltca/te_vs_load.md)"
+    ),
+}
+
+
 @dataclass(frozen=True)
 class TrendPoint:
     """The seed face gear's headline numbers at one load.
@@ -596,7 +607,8 @@ def load_trend_rows(trends: dict[tuple[str, int], list[TrendPoint]]) -> list[Row
         vals = []
         for (fid, lv), pts in trends.items():
             s = tuple(getattr(p, attr) for p in pts)
-            vals.append(Value(fid, lv, s[-1], series=s, seconds=sum(p.seconds for p in pts)))
+            vals.append(Value(fid, lv, s[-1], series=s, seconds=sum(p.seconds for p in pts),
+                              note=TREND_NOTES.get(fid, "")))  # fmt: skip
         rows.append(
             Row(
                 key=f"trend_{attr}",
