@@ -615,7 +615,11 @@ def cross_compliance(
     Qs = sp.csr_matrix(Q)[op.dofs[rq], :]
     Ps = sp.csr_matrix(P)[op.cols[rp], :]
     # Sparse times dense (a column of P or Q has 30-120 entries): measured 2.7x faster than
-    # densifying them for a BLAS product at the sizes of a contact zone (500 x 700 rows).
-    X = Ps.T @ op.take(rq, rp).T  # (n_cells, n_rq)
-    C = np.asarray(Qs.T @ X.T)
+    # densifying them for a BLAS product at the sizes of a contact zone (500 x 700 rows). Read
+    # first (Qᵀ G, on G's rows as gathered): only the (n_probe, n_rp) product is transposed for
+    # SciPy's kernel, not the (n_rq, n_rp) block of G. A NaN of G (an entry no block holds)
+    # reaches only the entries of C whose reading and load touch it: the sparse products add
+    # only the stored entries of Q and P.
+    A = Qs.T @ op.take(rq, rp)  # (n_probe, n_rp)
+    C = np.asarray(Ps.T @ A.T).T
     return 0.5 * (C + C.T) if symmetric else C
