@@ -403,13 +403,20 @@ def locate_inside(mesh: skfem.MeshTet, points: np.ndarray) -> SurfacePoints:
     return SurfacePoints(tets=tets, local=xi, distance=np.zeros(pts.shape[0]))
 
 
-def probe_operator(body: ElasticBody, points: np.ndarray, directions: np.ndarray) -> sp.csr_matrix:
+def probe_operator(
+    body: ElasticBody,
+    points: np.ndarray,
+    directions: np.ndarray,
+    located: SurfacePoints | None = None,
+) -> sp.csr_matrix:
     """``Q`` (n_dofs × n): column ``i`` reads the displacement at ``points[i]`` along
-    ``directions[i]`` (``w_i = Q_i^T u``); the points may be anywhere inside the body."""
+    ``directions[i]`` (``w_i = Q_i^T u``); the points may be anywhere inside the body.
+    ``located``: their tetrahedra and reference coordinates if known (:func:`find_tets`, every
+    point found), else :func:`locate_inside` finds them."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     e = np.asarray(directions, dtype=float).reshape(-1, 3)
     n = pts.shape[0]
-    loc = locate_inside(body.mesh, pts)
+    loc = locate_inside(body.mesh, pts) if located is None else located
     return _shape_operator(body, loc, np.ones(n), np.arange(n), e, n)
 
 

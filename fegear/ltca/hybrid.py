@@ -37,7 +37,7 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from fegear.compliance import cross_compliance, find_tets, probe_operator
+from fegear.compliance import SurfacePoints, cross_compliance, find_tets, probe_operator
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.ltca.model import cell_load_operators
@@ -60,14 +60,15 @@ def _probe(model, M, x, inward, P, depth: float) -> tuple[sp.csc_matrix, np.ndar
     x0 = apply_points(Minv, x)
     d = np.full(x0.shape[0], depth)
     for _ in range(4):
-        tets, _ = find_tets(model.body.mesh, x0 + d[:, None] * e)
+        tets, xi = find_tets(model.body.mesh, x0 + d[:, None] * e)
         bad = tets < 0
         bad[~bad] = ~model.layer_tets[tets[~bad]]
         if not bad.any():
             break
         d[bad] *= 0.5
-    good = np.flatnonzero(~bad)
-    Q = probe_operator(model.body, x0[good] + d[good, None] * e[good], e[good])
+    good = np.flatnonzero(~bad)  # found at their depth d by the last search: not searched again
+    loc = SurfacePoints(tets[good], xi[good], np.zeros(good.size))
+    Q = probe_operator(model.body, x0[good] + d[good, None] * e[good], e[good], located=loc)
     if bad.any():
         d[bad] = 0.0
         log.debug("%s: %d hybrid cells read at the surface", model.name, int(bad.sum()))
@@ -154,29 +155,32 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
     n1 = np.concatenate([c.normals for c in have])
     x1 = np.concatenate([c.centers for c in have])
     x2 = x1 + np.concatenate([c.gap[:, None] * c.normals for c in have])
-    Q1, d1 = _probe(models.pinion, M1, x1, -n1, R1.tocsc(), models.depth_mm)
-    Q2, d2 = _probe(models.gear, M2, x2, n1, R2.tocsc(), models.depth_mm)
+    R1, R2 = R1.tocsc(), R2.tocsc()
+    Q1, d1 = _probe(models.pinion, M1, x1, -n1, R1, models.depth_mm)
+    Q2, d2 = _probe(models.gear, M2, x2, n1, R2, models.depth_mm)
     ends_l = np.cumsum([0] + [c.n for c in loaded])
     ends_r = np.cumsum([0] + [c.n for c in readers])
     F = np.asarray(forces, dtype=float)
-    # Per pair p: the load of its own cells (read at depth) and that of the other pairs (read at
-    # the surface): one column each, all read in one product per member.
+    # Per pair p: the load of its own cells (read at depth by Q) and that of the other pairs
+    # (read at the surface by R), each read only by p's readers: the operator's entries between
+    # p's readers and those loads only (a layer under one tooth is never read under another's).
     own = np.zeros((F.size, len(loaded)))
     for p in range(len(loaded)):
         own[ends_l[p] : ends_l[p + 1], p] = F[ends_l[p] : ends_l[p + 1]]
     other = F[:, None] - own
     u = np.zeros(int(ends_r[-1]))
     for op, Q, R, P in ((models.pinion.op, Q1, R1, loads[0]), (models.gear.op, Q2, R2, loads[1])):
-        cols = sp.csc_matrix(P @ np.hstack([own, other]))
-        W = cross_compliance(op, sp.hstack([Q, R]).tocsc(), cols)  # (2 n_read, 2 n_pairs)
-        nr = Q.shape[1]
         at = 0
         for p, c in enumerate(readers):
             if c.n == 0:
                 continue
-            rows = np.arange(ends_r[p], ends_r[p + 1])
-            u[rows] += W[at : at + c.n, p] + W[nr + at : nr + at + c.n, len(loaded) + p]
+            sub = slice(at, at + c.n)
             at += c.n
+            w = np.zeros(c.n)
+            for M, f in ((Q, own[:, p]), (R, other[:, p])):
+                if f.any():
+                    w += cross_compliance(op, M[:, sub], sp.csc_matrix(P @ f[:, None]))[:, 0]
+            u[ends_r[p] : ends_r[p + 1]] += w
     # The layer compression of each member from the pair's own loaded cells.
     at = 0
     for p, (cl, cr) in enumerate(zip(loaded, readers, strict=True)):
