@@ -279,6 +279,11 @@ class Cycle:
     hertz_p0_max_MPa
         Fidelity ``tca``: the largest Hertz pressure of the unloaded contact points under the
         case's torque (MPa).
+    root_stress_max_MPa, root_stress_reason
+        ``summary.json``'s ``cycle.root_stress_max_MPa``: per member the largest tension-fillet
+        maximum principal stress, the most compressive compression-fillet minimum principal
+        stress and the largest von Mises stress of the loaded teeth over the cycle, with where
+        (fidelities ``fe``, ``hybrid``); None and the reason otherwise.
     """
 
     n_positions: int
@@ -302,6 +307,8 @@ class Cycle:
     positions_with_edge_contact: tuple[int, ...]
     max_equilibrium_residual: float | None
     hertz_p0_max_MPa: float | None = None
+    root_stress_max_MPa: Mapping[str, Any] | None = None
+    root_stress_reason: str = ""
 
     @classmethod
     def _from(cls, c: Mapping[str, Any]) -> Cycle:
@@ -332,6 +339,8 @@ class Cycle:
             positions_with_edge_contact=tuple(c.get("positions_with_edge_contact", ())),
             max_equilibrium_residual=_opt_float(c.get("max_equilibrium_residual")),
             hertz_p0_max_MPa=_opt_float(c.get("hertz_p0_max_MPa")),
+            root_stress_max_MPa=c.get("root_stress_max_MPa"),
+            root_stress_reason=str(c.get("root_stress_reason", "")),
         )
 
 
@@ -475,6 +484,30 @@ class GearResult:
 
         out = check_writable_folder(folder, "folder")
         return tuple(write_gear_outputs(out, self.run, self._views))
+
+    def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:
+        """Root stress of each tooth of ``member`` (``"pinion"``/``"gear"``) that can touch:
+        ``{tooth: (n_positions,) MPa}``, ``what`` one of ``"tension"`` (largest maximum
+        principal stress in the fillet on the loaded-flank side), ``"compression"`` (smallest
+        minimum principal stress on the other side), ``"von_mises"`` (NaN without contact;
+        :mod:`fegear.fem.stress`).
+
+        Raises
+        ------
+        InputError
+            A bad ``member`` or ``what``, or a fidelity without stress sectors (``tca``,
+            ``hertz``).
+        """
+        fields = {"tension": "tension_MPa", "compression": "compression_MPa",
+                  "von_mises": "von_mises_MPa"}  # fmt: skip
+        if what not in fields:
+            raise InputError("what", what, f"one of {sorted(fields)}")
+        mf = next((m for m in self.run.members if m.name == member), None)
+        if member not in ("pinion", "gear"):
+            raise InputError("member", member, "'pinion' or 'gear'")
+        if mf is None or not mf.root:
+            raise InputError("fidelity", self.fidelity, "'hybrid' or 'fe' (cell loads on the FE)")
+        return {t: mf.root_series(t, fields[what]) for t in mf.root_teeth}
 
     def plot_pattern(self, path: str | Path, member: str = "gear") -> Path:
         """The bearing pattern over the cycle on one member's flank as a PNG: the largest

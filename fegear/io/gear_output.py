@@ -27,6 +27,15 @@ Files written to the output folder (each one atomically: complete or absent):
   ``positions[i].pairs[j].p_max_MPa``, ``positions[i].pairs[j].contact_point_mm``,
   ``positions[i].pairs[j].edge_contact``, ``cycle.contact_zone`` (``sector_teeth``, ``pairs``,
   ``gap_mm``: what the sectors modelled). (Fidelity ``tca``: the loaded values are ``null``.)
+  Root stress (fidelities ``fe`` and ``hybrid``, from the stress sectors under the cell forces,
+  :mod:`fegear.fem.stress`): ``positions[i].members[k]`` (``name``, ``root_stress_MPa``: per
+  tooth that can touch ``tooth``, ``loaded``, ``tension_max_principal`` (largest σ1 in the
+  fillet on the loaded-flank side), ``compression_min_principal`` (smallest σ3 on the other
+  side), ``von_mises_max``, each with ``*_at``: ``point_mm`` in the member frame,
+  ``radius_mm``, ``axial_mm``; ``stress_equilibrium``: reaction against load, relative);
+  ``cycle.root_stress_max_MPa`` (per member the extremes over the loaded teeth and positions,
+  where), ``cycle.root_stress_fillet_mm``, ``cycle.root_stress_max_equilibrium_residual``
+  (``null`` with ``cycle.root_stress_reason`` at ``hertz``).
 - ``vtk/pinion_<i>.vtu``, ``vtk/gear_<i>.vtu`` (fidelity ``fe``) — the sector of each member
   in its assembled position at position ``i`` (fixed frame, mm; the gear at its unloaded
   TCA-closed angle ``ratio·φ1 + TE_unloaded``, the elastic lag is not added), linear tets, with
@@ -34,7 +43,9 @@ Files written to the output folder (each one atomically: complete or absent):
   ``pressure_MPa`` (the pressure of the contact cell over each working-flank vertex, raised to
   that of the loaded cells whose nearest vertex it is, else 0: a display of the patch on the
   element mesh; the exact field is in the contact cells) and
-  ``in_contact`` (1 on loaded flank vertices).
+  ``in_contact`` (1 on loaded flank vertices), ``max_principal_stress_MPa``,
+  ``min_principal_stress_MPa``, ``von_mises_MPa`` (the recovered vertex stresses; the sectors
+  are the stress sectors, fillets refined).
 - ``vtk/contact_cells_<i>.vtu`` — the contact cells of all pairs as quads on the pinion flank
   (fixed frame) with cell data ``force_N``, ``pressure_MPa``, ``area_mm2`` (so that
   ``Σ pressure·area = Σ force``), ``gap_mm``, ``active``, ``edge``, ``pair``,
@@ -53,7 +64,8 @@ Files written to the output folder (each one atomically: complete or absent):
   4 gear flank view; open it in ParaView and press play.
 - PNGs: ``te.png`` (unloaded and loaded TE), ``load_share.png``, ``p_max.png``,
   ``bearing_pattern.png`` (union of the loaded cells on the pinion flank, coloured by the largest
-  pressure seen over the cycle). Fidelity ``tca``: ``te.png`` and ``bearing_pattern.png``
+  pressure seen over the cycle), ``root_stress.png`` (per member, the root stress of one tooth
+  over its passage through the mesh). Fidelity ``tca``: ``te.png`` and ``bearing_pattern.png``
   (unloaded, paint thickness).
 """
 
@@ -213,9 +225,96 @@ def _fe_positions(run: GearRun) -> list[dict[str, Any]]:
                     "g_max_mm": p.g_max_mm,
                 },
                 "warnings": list(p.warnings),
+                "members": [_member_stress_row(mf, i) for mf in run.members],
             }
         )
     return rows
+
+
+def _point_row(x: tuple[float, float, float]) -> dict[str, Any]:
+    return {
+        "point_mm": [float(v) for v in x],
+        "radius_mm": float(math.hypot(x[0], x[1])),
+        "axial_mm": float(x[2]),
+    }
+
+
+def _member_stress_row(mf, i: int) -> dict[str, Any]:
+    """``positions[i].members[k]``: the root stress of every tooth of member ``mf`` that can
+    touch (:class:`fegear.fem.stress.ToothRootStress`) and the equilibrium of its stress solve."""
+    eq = mf.equilibrium[i] if i < len(mf.equilibrium) else None
+    return {
+        "name": mf.name,
+        "root_stress_MPa": [
+            {
+                "tooth": r.tooth,
+                "loaded": r.loaded,
+                "tension_max_principal": r.tension_MPa,
+                "compression_min_principal": r.compression_MPa,
+                "von_mises_max": r.von_mises_MPa,
+                "tension_at": _point_row(r.tension_point),
+                "compression_at": _point_row(r.compression_point),
+                "von_mises_at": _point_row(r.von_mises_point),
+            }
+            for r in (mf.root[i] if i < len(mf.root) else ())
+        ],
+        "stress_equilibrium": None
+        if eq is None
+        else {
+            "force_residual": eq.force_residual,
+            "moment_residual": eq.moment_residual,
+            "applied_N": [float(v) for v in eq.applied_N],
+        },
+    }
+
+
+def _root_stress_cycle(run: GearRun) -> dict[str, Any]:
+    """``cycle.root_stress_max_MPa`` (per member: the largest tension, the most compressive
+    compression and the largest von Mises stress of the loaded teeth over the positions, where),
+    ``cycle.root_stress_fillet_mm``, ``cycle.root_stress_max_equilibrium_residual``; null with
+    ``cycle.root_stress_reason`` where the fidelity has no cell loads."""
+    if not run.members or not any(mf.root for mf in run.members):
+        why = (
+            "the hertz fidelity has no contact cells: no loads on the sector FE"
+            if run.fidelity == "hertz"
+            else "no loaded position"
+        )
+        return {
+            "root_stress_max_MPa": None,
+            "root_stress_reason": why,
+            "root_stress_fillet_mm": None,
+            "root_stress_max_equilibrium_residual": None,
+        }
+    out: dict[str, Any] = {}
+    for mf in run.members:
+        rows = [(i, r) for i, row in enumerate(mf.root) for r in row if r.loaded]
+        if not rows:
+            out[mf.name] = None
+            continue
+        it, t = max(rows, key=lambda x: x[1].tension_MPa)
+        ic, c = min(rows, key=lambda x: x[1].compression_MPa)
+        iv, v = max(rows, key=lambda x: x[1].von_mises_MPa)
+        out[mf.name] = {
+            "tension_max_principal": t.tension_MPa,
+            "tension_at": {"position": it, "tooth": t.tooth, **_point_row(t.tension_point)},
+            "compression_min_principal": c.compression_MPa,
+            "compression_at": {
+                "position": ic,
+                "tooth": c.tooth,
+                **_point_row(c.compression_point),
+            },  # fmt: skip
+            "von_mises_max": v.von_mises_MPa,
+            "von_mises_at": {"position": iv, "tooth": v.tooth, **_point_row(v.von_mises_point)},
+        }
+    eqs = [e for mf in run.members for e in mf.equilibrium if e is not None]
+    return {
+        "root_stress_max_MPa": out,
+        "root_stress_reason": "",
+        "root_stress_fillet_mm": {mf.name: mf.fillet_mm for mf in run.members},
+        "root_stress_max_equilibrium_residual": max(
+            (max(e.force_residual, e.moment_residual) for e in eqs), default=None
+        ),
+    }
 
 
 def _tca_positions(run: GearRun) -> list[dict[str, Any]]:
@@ -331,6 +430,7 @@ def gear_summary(
                 (s.complementarity_residual for s in sols), default=0.0
             ),
             "max_penetration_mm": max((s.max_penetration for s in sols), default=0.0),
+            **_root_stress_cycle(run),
             **checks,
         }
         if c.zone is not None:
@@ -479,15 +579,12 @@ def _member_mesh(mf, i: int, pos):
     X = apply_points(M, mf.points)
     u = apply_vectors(M, mf.displacement[i])
     p = _node_pressure(mf, i, pos, X)
-    return meshio.Mesh(
-        X,
-        [("tetra", mf.tets)],
-        point_data={
-            "displacement_mm": u,
-            "pressure_MPa": p,
-            "in_contact": (p > 0).astype(np.int32),
-        },
-    )
+    data = {"displacement_mm": u, "pressure_MPa": p, "in_contact": (p > 0).astype(np.int32)}
+    if mf.max_principal is not None:
+        data["max_principal_stress_MPa"] = mf.max_principal[i]
+        data["min_principal_stress_MPa"] = mf.min_principal[i]
+        data["von_mises_MPa"] = mf.von_mises[i]
+    return meshio.Mesh(X, [("tetra", mf.tets)], point_data=data)
 
 
 def write_pvd(path: Path, entries: list[tuple[float, int, str]], parts: str = "") -> Path:
@@ -636,6 +733,61 @@ def _plot_p_max(out: Path, run: GearRun) -> Path:
     return _save(fig, out / "p_max.png")
 
 
+def _one_tooth(mf, phi1_deg: np.ndarray, pitch_deg: float):
+    """The root stress of one tooth over its whole passage through the mesh, pieced together
+    from the teeth of the cycle: tooth ``t`` at ``φ1`` is tooth 0 at ``φ1 − σ t p`` (``p`` the
+    pinion's angular pitch; ``σ = ±1``, the sense that makes the loaded stretches of the teeth
+    one: the smaller spread). Returns ``(x_deg, tension, compression)`` sorted by ``x``."""
+    teeth = mf.root_teeth
+    best = None
+    for sigma in (1.0, -1.0):
+        xs = [phi1_deg - sigma * t * pitch_deg for t in teeth]
+        loaded = [
+            x[[any(r.tooth == t and r.loaded for r in row) for row in mf.root]]
+            for t, x in zip(teeth, xs, strict=True)
+        ]
+        centres = [float(np.mean(v)) for v in loaded if v.size]
+        spread = float(np.ptp(centres)) if centres else 0.0
+        if best is None or spread < best[0]:
+            best = (spread, xs)
+    x = np.concatenate(best[1])
+    ten = np.concatenate([mf.root_series(t) for t in teeth])
+    com = np.concatenate([mf.root_series(t, "compression_MPa") for t in teeth])
+    o = np.argsort(x)
+    return x[o], ten[o], com[o]
+
+
+def _plot_root_stress(out: Path, run: GearRun) -> Path:
+    """``root_stress.png``: per member, the tension-fillet maximum principal stress and the
+    compression-fillet minimum principal stress of one tooth over its passage through the mesh
+    (:func:`_one_tooth`), against the pinion angle of the cycle."""
+    plt = _plt()
+    c = run.cycle
+    deg = np.degrees(c.phi1)
+    pitch = 360.0 / run.assembly.n1
+    fig, axes = plt.subplots(1, len(run.members), figsize=(11, 4), squeeze=False)
+    for ax, mf in zip(axes[0], run.members, strict=True):
+        if not mf.root_teeth:
+            ax.set_title(f"{mf.name}: no loaded position", fontsize=9)
+            continue
+        x, ten, com = _one_tooth(mf, deg, pitch)
+        ax.plot(x, ten, "o-", ms=3, color="tab:red", label="tension fillet, max principal")
+        ax.plot(x, com, "s--", ms=3, color="tab:blue", label="compression fillet, min principal")
+        ax.axhline(0.0, color="gray", lw=0.5)
+        ax.set_xlabel("pinion angle of the tooth's passage φ1 (deg)")
+        ax.set_ylabel("root stress (MPa)")
+        top = float(np.nanmax(ten))
+        ax.set_title(
+            f"{mf.name}: one tooth through the mesh; max {top:.0f} MPa "
+            f"(fillet elements {mf.fillet_mm:.3g} mm)",
+            fontsize=9,
+        )
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(_title(run), fontsize=9)
+    return _save(fig, out / "root_stress.png")
+
+
 def _flank_bounds(run: GearRun):
     m, side = run.pair.pinion, run.assembly.side1
     try:
@@ -781,6 +933,8 @@ def write_gear_outputs(out: Path, run: GearRun, views: FlankViews | None = None)
         paths += _write_vtk(out, run, views)
         paths += [_plot_te(out, run), _plot_load_share(out, run), _plot_p_max(out, run),
                   _plot_pattern(out, run)]  # fmt: skip
+        if run.members and any(mf.root for mf in run.members):
+            paths.append(_plot_root_stress(out, run))
     else:
         paths += _tca_plots(out, run)
     files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]

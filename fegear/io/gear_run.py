@@ -103,6 +103,10 @@ class MemberField:
         contact).
     fillet_mm
         Element size on the fillets of the stress sector (mm).
+    dofs, body
+        ``(n_dofs, n_positions)`` mm, the P2 displacement in the full DOF numbering, and the
+        :class:`~fegear.fem.elasticity.ElasticBody` of the stress sector (only when
+        :func:`displacements` is asked to keep them: studies of the recovery).
     """
 
     name: str
@@ -118,6 +122,8 @@ class MemberField:
     root: tuple[tuple[Any, ...], ...] = ()
     equilibrium: tuple[Any, ...] = ()
     fillet_mm: float | None = None
+    dofs: Array | None = None
+    body: Any = None
 
     @property
     def root_teeth(self) -> tuple[int, ...]:
@@ -368,14 +374,19 @@ def _override(case: GearCase, fidelity: str | None, level: int | None) -> GearCa
 
 
 def _linear_solver(K: sp.csr_matrix) -> tuple[Callable[[Array], Array], str]:
-    """A solver of ``K X = B`` for several right-hand sides (one factorisation)."""
+    """A solver of ``K X = B`` (``K`` symmetric positive definite) for several right-hand sides
+    (one factorisation): PARDISO's Cholesky (``mtype = 2``, the upper triangle) where
+    ``pypardiso`` is installed, measured 30 s against 52 s for its default LU (``mtype = 11``)
+    on a 192k-DOF stress sector of the FZG pinion (2 busy cores, residuals 3e-14 / 2e-14)."""
     try:
         import pypardiso
 
-        solver = pypardiso.PyPardisoSolver()
+        solver = pypardiso.PyPardisoSolver(mtype=2)
+        upper = sp.triu(K, format="csr")
+        upper.sort_indices()
 
         def solve(B: Array) -> Array:
-            return np.asarray(solver.solve(K, np.ascontiguousarray(B))).reshape(B.shape)
+            return np.asarray(solver.solve(upper, np.ascontiguousarray(B))).reshape(B.shape)
 
         return solve, "pypardiso"
     except Exception:  # noqa: BLE001  (pypardiso or MKL missing: the portable fallback)
@@ -435,7 +446,14 @@ def stress_sector(member, model, zone, fillet_mm: float):
 
 
 def displacements(
-    run_pair: GearPair, asm, models, cycle, phi2: Array, fillet_modules: float | None = None
+    run_pair: GearPair,
+    asm,
+    models,
+    cycle,
+    phi2: Array,
+    fillet_modules: float | None = None,
+    refine_teeth: dict[str, tuple[int, ...]] | None = None,
+    keep_dofs: bool = False,
 ) -> tuple[MemberField, ...]:
     """Displacement and stress of both stress sectors at every position: ``u = K⁻¹ P F``.
 
@@ -450,6 +468,10 @@ def displacements(
     (TCA-closed) angle. Then, per position, the recovered vertex stresses, the root stress of
     every tooth that can touch (:func:`fegear.fem.stress.tooth_root_stress`) and the
     equilibrium of the solve (:func:`fegear.fem.stress.reactions`).
+
+    ``refine_teeth``: ``{member: sector teeth}`` whose zone (and fillets) the stress sector
+    refines (default: all the zone teeth; a refinement study refines the tooth it reads only);
+    ``keep_dofs``: keep the P2 displacement and the body in the :class:`MemberField`.
     """
     from fegear.fem.assembly import elasticity_stiffness
     from fegear.fem.stress import (
@@ -476,6 +498,8 @@ def displacements(
         p = model.sector.parameters
         module = float(p["h_fine_mm"]) / FINE[int(p["level"])]
         boxes = None if zone is None else (zone.pinion if name == "pinion" else zone.gear)
+        if refine_teeth is not None and name in refine_teeth and boxes:
+            boxes = tuple(z for z in boxes if z.tooth in refine_teeth[name])
         t0 = time.perf_counter()
         smodel = stress_sector(member, model, boxes, fm * module)
         body = smodel.body
@@ -554,6 +578,8 @@ def displacements(
                 root=tuple(root),
                 equilibrium=tuple(equil),
                 fillet_mm=fm * module,
+                dofs=full if keep_dofs else None,
+                body=body if keep_dofs else None,
             )
         )
     return tuple(out)

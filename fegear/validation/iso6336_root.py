@@ -73,7 +73,9 @@ import numpy as np
 from fegear.errors import FegearError, InputError
 
 __all__ = [
+    "CriticalSection",
     "RootFactors",
+    "critical_section_check",
     "root_factors",
     "nominal_root_stress",
     "contact_ratio",
@@ -213,6 +215,77 @@ def nominal_root_stress(
     return Ft / (b * mn) * f.YF * f.YS * Ybeta
 
 
+@dataclass(frozen=True)
+class CriticalSection:
+    """The 30° tangent section measured on a generated tooth (mm).
+
+    Attributes
+    ----------
+    sFn
+        Chord between the points of the two fillets whose tangent makes 30° with the tooth
+        centre line.
+    rhoF
+        Radius of curvature of the fillet there (mean of both sides).
+    hFe
+        Distance along the centre line from that chord to the point where the load line
+        through the profile point at ``den/2`` (normal to the involute, tangent to the base
+        circle) crosses the centre line.
+    """
+
+    sFn: float
+    rhoF: float
+    hFe: float
+
+
+def critical_section_check(member, den: float, n: int = 4001) -> CriticalSection:
+    """:class:`CriticalSection` of tooth 0 of an involute spur ``member`` measured on its
+    generated transverse profile (fillet: the envelope of the rack tip circle; flank: the
+    involute), independently of the ISO 6336-3 closed forms: ``n`` exact points of each side's
+    fillet at mid-face, tangent angles and curvature from their finite differences
+    (``np.gradient``, second order), the 30° points by linear interpolation; ``den`` (mm) the
+    diameter of the load point."""
+    b = member.boundaries("drive")
+    u = np.linspace(b.u_root, b.u_fillet, n)
+    pts = {}
+    for side in ("drive", "coast"):
+        bs = member.boundaries(side)
+        us = np.linspace(bs.u_root, bs.u_fillet, n)
+        P, _ = member.point_normal(side, us, np.zeros_like(us))
+        pts[side] = P[:, :2]
+    # tooth centre line: the bisector of the two flanks (symmetric tooth)
+    mid = pts["drive"][-1] + pts["coast"][-1]
+    axis = mid / np.linalg.norm(mid)
+    perp = np.array([-axis[1], axis[0]])
+    found = {}
+    for side, P in pts.items():
+        d = np.gradient(P, u, axis=0)
+        dd = np.gradient(d, u, axis=0)
+        tang = d / np.linalg.norm(d, axis=1, keepdims=True)
+        ang = np.degrees(np.arccos(np.abs(tang @ axis)))  # angle to the centre line
+        i = int(np.flatnonzero(np.diff(np.sign(ang - 30.0)))[0])
+        w = (30.0 - ang[i]) / (ang[i + 1] - ang[i])
+        x = P[i] + w * (P[i + 1] - P[i])
+        kap = np.abs(d[:, 0] * dd[:, 1] - d[:, 1] * dd[:, 0]) / np.linalg.norm(d, axis=1) ** 3
+        found[side] = (x, 1.0 / ((1 - w) * kap[i] + w * kap[i + 1]))
+    (xd, rd), (xc, rc) = found["drive"], found["coast"]
+    sFn = float(abs((xd - xc) @ perp))
+    h_chord = float(0.5 * (xd + xc) @ axis)
+    # load point: the drive flank at radius den/2; load line along the involute normal
+    rb = float(member.r_b)
+    r = 0.5 * den
+    bd = member.boundaries("drive")
+    uu = np.linspace(bd.u_fillet, bd.u_tip, 4001)
+    F, N = member.point_normal("drive", uu, np.zeros_like(uu))
+    j = int(np.argmin(np.abs(np.hypot(F[:, 0], F[:, 1]) - r)))
+    p0, nrm = F[j, :2], N[j, :2]
+    # p0 + t nrm on the centre line: (p0 + t nrm) · perp = 0
+    t = -(p0 @ perp) / (nrm @ perp)
+    h_load = float((p0 + t * nrm) @ axis)
+    if not rb < r:
+        raise InputError("den", den, f"above the base diameter {2 * rb:.3f} mm")
+    return CriticalSection(sFn=sFn, rhoF=0.5 * (rd + rc), hFe=h_load - h_chord)
+
+
 def _design(member):
     d = getattr(member, "design", None)
     if d is None or getattr(d, "helix_angle_deg", 0.0) != 0.0:
@@ -251,8 +324,9 @@ def _fzg_case():
 
 
 def single_contact_phi1(pair) -> dict[str, float]:
-    """``{"pinion": φ_D, "gear": φ_B}`` (rad): pinion angles at which the rigid contact of one pair
-    lies at the outer point of single contact of the pinion (D, ``p_b`` beyond the start of
+    """``{"pitch": φ_C, "pinion": φ_D, "gear": φ_B}`` (rad): pinion angles at which the rigid
+    contact of one pair lies at the outer point of single contact of the pinion (D, ``p_b``
+    beyond the start of
     contact A) and of the gear (B, ``p_b`` before the end E), from the pitch point angle
     (:func:`fegear.validation.rows.pitch_point_phi1`) and ``r_b1`` of travel per radian; the sense
     of travel is read from the TCA (the pinion contact radius grows towards the pinion tip)."""
@@ -283,6 +357,7 @@ def single_contact_phi1(pair) -> dict[str, float]:
         radii.append(float(L[np.argmin(np.abs(L - L_C))]))
     sense = 1.0 if radii[1] > radii[0] else -1.0
     return {
+        "pitch": phi_c,
         "pinion": phi_c + sense * (L_A + pb - L_C) / rb1,
         "gear": phi_c + sense * (L_E - pb - L_C) / rb1,
     }
@@ -290,33 +365,45 @@ def single_contact_phi1(pair) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class FERootStress:
-    """fegear's root stress of one member's loaded tooth at one pinion angle.
+    """fegear's root stress of one member's tooth with the load at its outer point of single
+    contact.
+
+    Under load the next pair takes over before the rigid transfer point (the teeth bend; the
+    FZG pair has no tip relief): at the rigid φ_D the pair carries about 0.6 of the torque. The
+    loaded outer point of single contact is where the tooth carries the whole load highest on
+    its flank, i.e. where its root stress peaks; it is found on ``n_window`` positions stepping
+    ``step_deg`` back from the rigid point (the peak is the largest of them).
 
     Attributes
     ----------
     member, fidelity, level
         Which member, how it ran.
-    phi1_deg
-        Pinion angle (deg).
     tooth
-        The member tooth read (the most loaded pair's).
+        The member tooth read (the pair in single contact at the start of the window).
+    phi1_deg
+        Pinion angle of the peak (deg).
     tension_MPa
-        Largest maximum principal stress in its tension fillet.
+        Largest maximum principal stress in its tension fillet there.
     load_share
-        Torque share of that pair.
+        Torque share of the pair there.
+    rigid_phi1_deg, rigid_tension_MPa, rigid_load_share
+        The same at the rigid outer point of single contact.
     fillet_mm
         Fillet element size of the stress sector.
     seconds
-        Wall time (analysis and stress solve).
+        Wall time of the analysis and the stress solves (both members).
     """
 
     member: str
     fidelity: str
     level: int
-    phi1_deg: float
     tooth: int
+    phi1_deg: float
     tension_MPa: float
     load_share: float
+    rigid_phi1_deg: float
+    rigid_tension_MPa: float
+    rigid_load_share: float
     fillet_mm: float
     seconds: float
 
@@ -326,46 +413,70 @@ def fe_root_stress(
     level: int = 0,
     case=None,
     fillet_modules: float | None = None,
-) -> dict[str, FERootStress]:
-    """fegear's root stress of the pinion at φ_D and of the gear at φ_B
-    (:func:`single_contact_phi1`): one loaded position each, then the stress sectors."""
+    n_window: int = 9,
+    step_deg: float = 0.25,
+):
+    """fegear's root stress of the pinion near φ_D and of the gear near φ_B
+    (:func:`single_contact_phi1`, :class:`FERootStress`): one loaded analysis over both windows,
+    then one stress solve per member. Returns ``({"pinion": …, "gear": …}, run)`` with
+    ``run = (pair, asm, models, cycle, phi2)``."""
     from fegear.io.gear_case import build_pair
     from fegear.io.gear_run import displacements
     from fegear.ltca import LTCAOptions, build_models, run_ltca
     from fegear.tca.results import ARCSEC
 
+    t0 = time.perf_counter()
     case = case or _fzg_case()
     pair = build_pair(case)
     where = single_contact_phi1(pair)
+    phi_c = where["pitch"]
+    steps = np.radians(step_deg) * np.arange(n_window)
+    windows = {}
+    for name in ("pinion", "gear"):
+        phi = where[name]
+        inward = 1.0 if phi_c > phi else -1.0  # towards the pitch point
+        windows[name] = phi + inward * steps[::-1]  # innermost first, the rigid point last
+    phi1 = np.concatenate([windows["pinion"], windows["gear"]])
     opt = LTCAOptions(level=level, fidelity=fidelity, n_teeth=case.n_teeth, E_MPa=case.E_MPa,
                       nu=case.nu, backend=case.backend, workers=1)  # fmt: skip
+    models = build_models(pair.pinion, pair.gear, pair.assembly, opt)
+    cyc = run_ltca(pair.pinion, pair.gear, pair.assembly, case.torque2_Nmm, opt, phi1=phi1,
+                   models=models)  # fmt: skip
+    if cyc.zone is not None and cyc.zone is not models.zone:
+        models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cyc.zone)
+    asm = pair.assembly.with_phase2(cyc.phase2)
+    phi2 = asm.ratio * cyc.phi1 + cyc.te_unloaded_arcsec * ARCSEC
+    fields = displacements(pair, asm, models, cyc, phi2, fillet_modules)
     out = {}
     for k, name in enumerate(("pinion", "gear")):
-        t0 = time.perf_counter()
-        models = build_models(pair.pinion, pair.gear, pair.assembly, opt)
-        cyc = run_ltca(pair.pinion, pair.gear, pair.assembly, case.torque2_Nmm, opt,
-                       phi1=np.array([where[name]]), models=models)  # fmt: skip
-        if cyc.zone is not None and cyc.zone is not models.zone:
-            models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cyc.zone)
-        asm = pair.assembly.with_phase2(cyc.phase2)
-        phi2 = asm.ratio * cyc.phi1 + cyc.te_unloaded_arcsec * ARCSEC
-        mf = displacements(pair, asm, models, cyc, phi2, fillet_modules)[k]
-        pos = cyc.positions[0]
-        q = max(pos.pairs, key=lambda q: q.force_N)
-        tooth = q.k if name == "pinion" else q.j
-        r = next(r for r in mf.root[0] if r.tooth == tooth)
+        mf = fields[k]
+        idx = np.arange(n_window) + k * n_window
+        first = cyc.positions[idx[0]]
+        q0 = max(first.pairs, key=lambda q: q.force_N)
+        tooth = int(q0.k if name == "pinion" else q0.j)
+
+        def share(i: int, name=name, tooth=tooth) -> float:
+            qs = [q for q in cyc.positions[i].pairs if (q.k if name == "pinion" else q.j) == tooth]
+            return float(qs[0].load_share) if qs else 0.0
+
+        s = mf.root_series(tooth)[idx]
+        best = int(idx[int(np.nanargmax(s))])
+        last = int(idx[-1])
         out[name] = FERootStress(
             member=name,
             fidelity=fidelity,
             level=level,
-            phi1_deg=math.degrees(where[name]),
-            tooth=int(tooth),
-            tension_MPa=r.tension_MPa,
-            load_share=float(q.load_share),
+            tooth=tooth,
+            phi1_deg=math.degrees(cyc.phi1[best]),
+            tension_MPa=float(np.nanmax(s)),
+            load_share=share(best),
+            rigid_phi1_deg=math.degrees(cyc.phi1[last]),
+            rigid_tension_MPa=float(s[-1]),
+            rigid_load_share=share(last),
             fillet_mm=float(mf.fillet_mm),
             seconds=time.perf_counter() - t0,
         )
-    return out
+    return out, (pair, asm, models, cyc, phi2)
 
 
 def rows(levels: tuple[int, ...] = (0, 1), fidelity: str = "hybrid", case=None) -> list:
@@ -376,7 +487,7 @@ def rows(levels: tuple[int, ...] = (0, 1), fidelity: str = "hybrid", case=None) 
 
     case = case or _fzg_case()
     ref = fzg_reference(case)
-    runs = [fe_root_stress(fidelity, lv, case) for lv in levels]
+    runs = [fe_root_stress(fidelity, lv, case)[0] for lv in levels]
     T = case.torque2_Nmm / 1000.0
     out = []
     for name, point in (("pinion", "D"), ("gear", "B")):
@@ -388,8 +499,10 @@ def rows(levels: tuple[int, ...] = (0, 1), fidelity: str = "hybrid", case=None) 
                 value=r[name].tension_MPa,
                 seconds=r[name].seconds,
                 note=(
-                    f"φ1 = {r[name].phi1_deg:.3f}°, tooth {r[name].tooth:+d}, load share "
-                    f"{r[name].load_share:.3f}, fillet elements {r[name].fillet_mm:.3g} mm"
+                    f"loaded outer point of single contact φ1 = {r[name].phi1_deg:.2f}° (share "
+                    f"{r[name].load_share:.3f}); at the rigid one ({r[name].rigid_phi1_deg:.2f}°, "
+                    f"share {r[name].rigid_load_share:.3f}) {r[name].rigid_tension_MPa:.1f} MPa; "
+                    f"fillet elements {r[name].fillet_mm:.3g} mm"
                 ),
             )
             for r in runs
