@@ -222,6 +222,36 @@ def _tet_affine(mesh: skfem.MeshTet) -> tuple[np.ndarray, np.ndarray]:
     return _memo(mesh, "affine", build)
 
 
+class _FacetFrames(NamedTuple):
+    """Per facet of a boundary (nf,): first vertex ``a`` and edges ``e1``, ``e2`` (nf, 3) mm,
+    their Gram entries ``g11, g12, g22`` and determinant ``det`` (nf,) mm⁴, centroid (nf, 3)."""
+
+    a: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+    g11: np.ndarray
+    g12: np.ndarray
+    g22: np.ndarray
+    det: np.ndarray
+    centroid: np.ndarray
+
+
+def _facet_frames(mesh: skfem.MeshTet, boundary: str) -> _FacetFrames:
+    """:class:`_FacetFrames` of ``boundary``, once per mesh (every cell location reads them)."""
+
+    def build() -> _FacetFrames:
+        tri = mesh.p[:, mesh.facets[:, mesh.boundaries[boundary]]].transpose(2, 1, 0)  # (nf,3,3)
+        a = tri[:, 0]
+        e1 = tri[:, 1] - a
+        e2 = tri[:, 2] - a
+        g11 = np.einsum("...i,...i", e1, e1)
+        g12 = np.einsum("...i,...i", e1, e2)
+        g22 = np.einsum("...i,...i", e2, e2)
+        return _FacetFrames(a, e1, e2, g11, g12, g22, g11 * g22 - g12 * g12, tri.mean(axis=1))
+
+    return _memo(mesh, "frames:" + boundary, build)
+
+
 def locate_on_boundary(
     mesh: skfem.MeshTet, boundary: str, points: np.ndarray, k: int = 12
 ) -> SurfacePoints:
@@ -245,22 +275,17 @@ def locate_on_boundary(
         raise InputError("boundary", boundary, f"one of {sorted(mesh.boundaries or {})}")
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     fac = mesh.boundaries[boundary]
-    tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3 nodes, 3 xyz)
-    tree = _tree(mesh, boundary, lambda: tri.mean(axis=1))
+    F = _facet_frames(mesh, boundary)
+    tree = _tree(mesh, boundary, lambda: F.centroid)
     kk = min(k, fac.size)
     _, cand = tree.query(pts, k=kk)
     cand = cand.reshape(pts.shape[0], kk)
-    a = tri[cand, 0]
-    e1 = tri[cand, 1] - a
-    e2 = tri[cand, 2] - a
+    a, e1, e2 = F.a[cand], F.e1[cand], F.e2[cand]
+    g11, g12, g22, det = F.g11[cand], F.g12[cand], F.g22[cand], F.det[cand]
     r = pts[:, None, :] - a
     # Least-squares barycentric coordinates (= orthogonal projection on the facet plane).
-    g11 = np.einsum("...i,...i", e1, e1)
-    g12 = np.einsum("...i,...i", e1, e2)
-    g22 = np.einsum("...i,...i", e2, e2)
     b1 = np.einsum("...i,...i", r, e1)
     b2 = np.einsum("...i,...i", r, e2)
-    det = g11 * g22 - g12 * g12
     s = (g22 * b1 - g12 * b2) / det
     t = (g11 * b2 - g12 * b1) / det
     bary_min = np.minimum(np.minimum(s, t), 1.0 - s - t)
