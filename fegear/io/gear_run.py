@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -384,6 +385,7 @@ def _linear_solver(K: sp.csr_matrix) -> tuple[Callable[[Array], Array], str]:
         solver = pypardiso.PyPardisoSolver(mtype=2)
         upper = sp.triu(K, format="csr")
         upper.sort_indices()
+        solver.factorize(upper)  # kept: a later solve with the same matrix back-substitutes
 
         def solve(B: Array) -> Array:
             return np.asarray(solver.solve(upper, np.ascontiguousarray(B))).reshape(B.shape)
@@ -394,6 +396,31 @@ def _linear_solver(K: sp.csr_matrix) -> tuple[Callable[[Array], Array], str]:
 
         lu = sla.splu(K.tocsc())
         return lu.solve, "superlu"
+
+
+#: Factorised stress sectors kept in the process (the last pair): runs of the same pair in one
+#: process (sweeps, scripts, the test session) solve by back-substitution only. A 190k-DOF FZG
+#: stress sector's Cholesky is some hundred MB, hence two.
+_FACTORS: OrderedDict[tuple, tuple[sp.csr_matrix, Callable[[Array], Array], str]] = OrderedDict()
+_MAX_FACTORS = 2
+
+
+def _factorised(sector, body) -> tuple[sp.csr_matrix, Callable[[Array], Array], str]:
+    """``(K_full, solve, backend)`` of a stress sector: the full stiffness (reactions) and the
+    solver on its free DOFs, from :data:`_FACTORS` when the same mesh (file), material and
+    clamping were factorised before in this process."""
+    from fegear.fem.assembly import elasticity_stiffness
+
+    key = (str(sector.path), body.E, body.nu, body.free.size, body.n_dofs)
+    if key in _FACTORS:
+        _FACTORS.move_to_end(key)
+        return _FACTORS[key]
+    K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
+    solve, used = _linear_solver(K[body.free][:, body.free].tocsr())
+    _FACTORS[key] = (K, solve, used)
+    while len(_FACTORS) > _MAX_FACTORS:
+        _FACTORS.popitem(last=False)
+    return K, solve, used
 
 
 def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
@@ -473,7 +500,6 @@ def displacements(
     refines (default: all the zone teeth; a refinement study refines the tooth it reads only);
     ``keep_dofs``: keep the P2 displacement and the body in the :class:`MemberField`.
     """
-    from fegear.fem.assembly import elasticity_stiffness
     from fegear.fem.stress import (
         CONTACT_CLEARANCE_MODULES,
         FILLET_MODULES,
@@ -531,8 +557,7 @@ def displacements(
         loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
         K = None
         if loaded.size:
-            K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
-            solve, used = _linear_solver(K[body.free][:, body.free].tocsr())
+            K, solve, used = _factorised(smodel.sector, body)
             full[body.free] = np.asarray(solve(np.ascontiguousarray(F[body.free]))).reshape(
                 body.free.size, n_pos
             )
