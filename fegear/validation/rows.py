@@ -63,6 +63,7 @@ __all__ = [
     "hertz_scene_rows",
     "load_trend",
     "load_trend_rows",
+    "trend_point",
     "pitch_point_phi1",
     "pitch_point_run",
     "root_stress_rows",
@@ -561,35 +562,38 @@ class TrendPoint:
     seconds: float
 
 
-def load_trend(fidelity: str = "hybrid", level: int = 0) -> list[TrendPoint]:
-    """The seed face gear at the three seed loads (:data:`TREND_CASES`) at one fidelity."""
+def trend_point(
+    name: str, fidelity: str = "hybrid", level: int = 0, workers: int = 1
+) -> TrendPoint:
+    """The seed face gear case ``name`` (one of :data:`TREND_CASES`) at one fidelity: its
+    :class:`TrendPoint`. ``workers`` processes solve the positions (the result does not depend
+    on it; each worker holds the operators: one keeps the memory low)."""
     from fegear.api import run
 
-    out = []
-    for name in TREND_CASES:
-        case = _case(name)
-        t0 = time.perf_counter()
-        r = run(case, fidelity=fidelity, level=level)
-        dt = time.perf_counter() - t0
-        axes = [
-            2.0 * q.semi_major_mm
-            for p in r.positions
-            if p.status == "ok"
-            for q in p.pairs
-            if q.in_contact and not q.edge_contact and q.semi_major_mm is not None
-        ]
-        te = r.te_loaded_arcsec
-        out.append(
-            TrendPoint(
-                torque2_Nmm=case.torque2_Nmm,
-                te_pp_arcsec=r.cycle.te_pp_loaded_arcsec,
-                te_mean_abs_arcsec=float(abs(np.nanmean(te))),
-                contact_ratio=r.cycle.contact_ratio_loaded,
-                patch_2a_mm=max(axes) if axes else None,
-                seconds=dt,
-            )
-        )
-    return out
+    case = _case(name)
+    t0 = time.perf_counter()
+    r = run(case, fidelity=fidelity, level=level, workers=workers)
+    dt = time.perf_counter() - t0
+    axes = [
+        2.0 * q.semi_major_mm
+        for p in r.positions
+        if p.status == "ok"
+        for q in p.pairs
+        if q.in_contact and not q.edge_contact and q.semi_major_mm is not None
+    ]
+    return TrendPoint(
+        torque2_Nmm=case.torque2_Nmm,
+        te_pp_arcsec=r.cycle.te_pp_loaded_arcsec,
+        te_mean_abs_arcsec=float(abs(np.nanmean(r.te_loaded_arcsec))),
+        contact_ratio=r.cycle.contact_ratio_loaded,
+        patch_2a_mm=max(axes) if axes else None,
+        seconds=dt,
+    )
+
+
+def load_trend(fidelity: str = "hybrid", level: int = 0, workers: int = 1) -> list[TrendPoint]:
+    """The seed face gear at the three seed loads (:data:`TREND_CASES`) at one fidelity."""
+    return [trend_point(name, fidelity, level, workers) for name in TREND_CASES]
 
 
 def load_trend_rows(trends: dict[tuple[str, int], list[TrendPoint]]) -> list[Row]:
