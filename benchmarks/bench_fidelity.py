@@ -21,7 +21,8 @@ Usage::
     python benchmarks/bench_fidelity.py spiral_bevel fe:0 fe:1 fe:2 hertz:0 hybrid:0
 
 Writes benchmarks/results/fidelity_SCENE.json / .md (merged with earlier runs of other specs; with
-no spec, only the .md is re-made from the .json);
+no spec, only the .md is re-made from the .json; benchmarks/results/fidelity_SCENE_notes.md, if
+present, is copied under the table);
 `python benchmarks/plot_pareto.py` draws docs/fidelity/pareto_*.png from them.
 """
 
@@ -87,16 +88,22 @@ def _child(path: Path, fid: str, level: int, npos: int, cache: str) -> dict:
 
 
 def run(scene: str, fid: str, level: int) -> dict:
+    """Cold and warm run of one ``FIDELITY:LEVEL``, with the 1-minute load average of the machine
+    before each (the other processes sharing the cores; 2 cores: above ~0.5 the times are not
+    those of an idle machine)."""
     path, npos = SCENES[scene]
     with tempfile.TemporaryDirectory() as cache:
+        load_cold = os.getloadavg()[0]
         cold = _child(path, fid, level, npos, cache)
         if "failed" in cold:
             return cold
+        load_warm = os.getloadavg()[0]
         warm = _child(path, fid, level, npos, cache)
     out = dict(cold)
     out["cold_s"] = cold["seconds"]
     out["warm_s"] = warm.get("seconds", float("nan"))
     out["warm_stages"] = warm.get("stages", {})
+    out["load_avg"] = [load_cold, load_warm]
     out["rss_MB"] = max(cold["rss_MB"], warm.get("rss_MB", 0.0))
     return out
 
@@ -147,13 +154,17 @@ def table(scene: str, runs: list[dict]) -> str:
         f"# Fidelity trade: {scene.replace('_', ' ')}",
         "",
         f"`python benchmarks/bench_fidelity.py {scene} ...` (2 cores; times exclude the "
-        "tooth-surface generation; p_max int. = over the positions where neither run has an "
+        "tooth-surface generation; warm positions = the warm run's time solving the positions "
+        "(the rest is reading the cached operators and TCA); load avg = the machine's 1-minute "
+        "load average before the cold / warm run (— not recorded); "
+        "p_max int. = over the positions where neither run has an "
         "edge contact; p_peak = the recovered peak of :func:`fegear.patch.measure_patch`, "
         "p_max = the largest cell pressure)",
         "",
-        "| fidelity | level | cold s | warm s | peak RSS MB | TE p-p ″ | mean TE ″ | contact ratio "
+        "| fidelity | level | cold s | warm s | warm positions s | load avg | peak RSS MB "
+        "| TE p-p ″ | mean TE ″ | contact ratio "
         f"| p_max / p_peak int. MPa | vs fe L{ref_fe['level']}: {what} |{vs_hy}",
-        "|---|---|---|---|---|---|---|---|---|---|" + ("---|" if ref_hy else ""),
+        "|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if ref_hy else ""),
     ]
 
     def err(e: dict) -> str:
@@ -169,8 +180,12 @@ def table(scene: str, runs: list[dict]) -> str:
             continue
         key = (r["fidelity"], r["level"])
         a = "reference" if key == ("fe", ref_fe["level"]) else err(r)
+        pos = r.get("warm_stages", {}).get("positions")
+        load = r.get("load_avg")
         row = (
             f"| {r['fidelity']} | {r['level']} | {r['cold_s']:.1f} | {r['warm_s']:.1f} | "
+            f"{'—' if pos is None else f'{pos:.1f}'} | "
+            f"{'—' if load is None else ' / '.join(f'{x:.2f}' for x in load)} | "
             f"{r['rss_MB']:.0f} | {r['te_pp']:.3f} | {r['te_mean']:.3f} | "
             f"{r['contact_ratio']:.2f} | {r['p_max_interior']:.0f} / {r['p_peak_interior']:.0f} | "
             f"{a} |"
@@ -192,8 +207,12 @@ def main() -> None:
         msg = r.get("failed") or f"cold {r['cold_s']:.1f} s, warm {r['warm_s']:.1f} s"
         print(f"{scene} {fid}:{lv}: {msg}", flush=True)
         out_json.write_text(json.dumps(runs, indent=1))
-    (HERE / "results" / f"fidelity_{scene}.md").write_text(table(scene, runs))
-    print(table(scene, runs))
+    text = table(scene, runs)
+    notes = HERE / "results" / f"fidelity_{scene}_notes.md"  # kept under the table
+    if notes.exists():
+        text += "\n" + notes.read_text()
+    (HERE / "results" / f"fidelity_{scene}.md").write_text(text)
+    print(text)
 
 
 if __name__ == "__main__":
