@@ -34,7 +34,8 @@ Files written to the output folder (each one atomically: complete or absent):
   side), ``von_mises_max``, each with ``*_at``: ``point_mm`` in the member frame,
   ``radius_mm``, ``axial_mm``; ``stress_equilibrium``: reaction against load, relative);
   ``cycle.root_stress_max_MPa`` (per member the extremes over the loaded teeth and positions,
-  where), ``cycle.root_stress_fillet_mm``, ``cycle.root_stress_max_equilibrium_residual``
+  where), ``cycle.root_stress_fillet_mm`` (``cycle.root_stress_notes``: why coarser than
+  0.1 m), ``cycle.root_stress_max_equilibrium_residual``
   (``null`` with ``cycle.root_stress_reason`` at ``hertz``).
 - ``vtk/pinion_<i>.vtu``, ``vtk/gear_<i>.vtu`` (fidelity ``fe``) — the sector of each member
   in its assembled position at position ``i`` (fixed frame, mm; the gear at its unloaded
@@ -283,6 +284,7 @@ def _root_stress_cycle(run: GearRun) -> dict[str, Any]:
             "root_stress_max_MPa": None,
             "root_stress_reason": why,
             "root_stress_fillet_mm": None,
+            "root_stress_notes": [],
             "root_stress_max_equilibrium_residual": None,
         }
     out: dict[str, Any] = {}
@@ -311,6 +313,7 @@ def _root_stress_cycle(run: GearRun) -> dict[str, Any]:
         "root_stress_max_MPa": out,
         "root_stress_reason": "",
         "root_stress_fillet_mm": {mf.name: mf.fillet_mm for mf in run.members},
+        "root_stress_notes": [mf.fillet_note for mf in run.members if mf.fillet_note],
         "root_stress_max_equilibrium_residual": max(
             (max(e.force_residual, e.moment_residual) for e in eqs), default=None
         ),
