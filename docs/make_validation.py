@@ -97,6 +97,22 @@ def measure(section: str) -> list[Row]:
     raise SystemExit(f"unknown section {section!r}: one of {', '.join(SECTIONS)}")
 
 
+def _failed(section: str, why: str) -> Row:
+    """The row of a section whose run failed (e.g. killed for memory): the reason, no numbers."""
+    return Row(
+        key=f"{section}_failed",
+        check=f"section `{section}`",
+        quantity="—",
+        reference=None,
+        reference_text="—",
+        values=(),
+        tolerance="—",
+        command=f"python docs/make_validation.py {section}",
+        test=V.TESTS,
+        pending=f"not measured: the run failed ({why}); rerun the section",
+    )
+
+
 def _num(x: float | None, ref: float | None = None) -> str:
     if x is None or not math.isfinite(x):
         return "—"
@@ -212,7 +228,12 @@ def main(argv: list[str]) -> None:
     for s in SECTIONS:
         if s in sections:
             t = time.perf_counter()
-            new[s] = [asdict(r) for r in measure(s)]
+            try:
+                new[s] = [asdict(r) for r in measure(s)]
+            except subprocess.CalledProcessError as e:  # the page says so: no number stands in
+                why = f"signal {-e.returncode}" if e.returncode < 0 else f"exit {e.returncode}"
+                log.warning("%s failed: %s", s, why)
+                new[s] = [asdict(_failed(s, f"{why} in `{' '.join(e.cmd[2:4])}`"))]
             log.warning("%s: %.0f s", s, time.perf_counter() - t)
         elif s in old:
             new[s] = old[s]
