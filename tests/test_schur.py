@@ -23,6 +23,7 @@ from fegear.linalg import (
     available_backends,
     inverse_block,
     inverse_columns,
+    inverse_off_block,
     resolve_backend,
     schur,
     schur_complement,
@@ -399,3 +400,45 @@ def test_an_operator_in_groups_has_the_blocks_of_the_whole_one() -> None:
     assert np.isnan(block(grouped, l1, f2)).all() and np.isnan(block(grouped, l2, f1)).all()
     with pytest.raises(InputError, match="groups"):
         candidate_operator(body, cand, "superlu", load_dofs=loads, groups=[(f1, l1), (f2, l1)])
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_inverse_off_block_is_the_rows_off_the_columns(box, reference, backend) -> None:
+    """Given ``G_ff``, the rows off the columns of ``(K⁻¹)_cc`` are those of the whole inverse;
+    a mask without both values, or a ``G_ff`` of another size, is refused."""
+    if backend == "pardiso":
+        _needs_pardiso()
+    K, idx = box
+    cols = np.arange(idx.size) % 3 == 0
+    G_ff = reference[np.ix_(cols, cols)]
+    G_lf = inverse_off_block(K, idx, cols, G_ff, backend)
+    assert _rel(G_lf, reference[np.ix_(~cols, cols)]) < TOL_SOLVERS
+    with pytest.raises(InputError, match="columns"):
+        inverse_off_block(K, idx, np.ones(idx.size, bool), reference, backend)
+    with pytest.raises(InputError, match="G_ff"):
+        inverse_off_block(K, idx, cols, G_ff[1:, 1:], backend)
+
+
+def test_an_operator_in_groups_is_read_back_block_for_block(tmp_path, monkeypatch) -> None:
+    """An operator in groups is stored as its blocks and read back bit for bit (memory-mapped);
+    ``take`` gives any rows and columns, NaN where no block holds them, as ``G`` does."""
+    from fegear.compliance import candidate_operator
+    from fegear.fem.elasticity import assemble_body
+
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path))
+    mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 4)] * 3).with_boundaries(
+        {"bottom": lambda x: x[2] < 1e-9}
+    )
+    body = assemble_body(mesh, 206000.0, 0.3, [("bottom", "xyz")])
+    free = body.free
+    f1, f2, l1, l2 = free[-12:-6], free[-6:], free[-40:-30], free[-30:-20]
+    cand, loads = np.concatenate([f1, f2, l1, l2]), np.concatenate([f1, f2])
+    key, groups = {"mesh": "unit cube 3x3x3", "clamped": "bottom"}, [(f1, l1), (f2, l2)]
+    first = candidate_operator(body, cand, "superlu", key, load_dofs=loads, groups=groups)
+    again = candidate_operator(body, cand, "superlu", key, load_dofs=loads, groups=groups)
+    assert not first.cache_hit and again.cache_hit and len(again.blocks) == 3
+    for a, b in zip(first.blocks, again.blocks, strict=True):
+        np.testing.assert_array_equal(np.asarray(b.G), a.G)
+    rows = np.random.default_rng(7).permutation(again.dofs.size)[:25]
+    cols = np.random.default_rng(8).permutation(again.cols.size)[:7]
+    np.testing.assert_array_equal(again.take(rows, cols), again.G[np.ix_(rows, cols)])
