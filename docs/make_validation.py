@@ -128,8 +128,22 @@ def _level(v) -> str:
     return "—" if v.level is None else str(v.level)
 
 
+def _cell(text: str) -> str:
+    """Markdown table cell text (a ``|`` would end the cell)."""
+    return text.replace("|", "\\|")
+
+
 def table(rows: list[Row]) -> str:
     """The summary table: one line per fegear value."""
+    rows = [
+        dataclasses.replace(
+            r,
+            check=_cell(r.check),
+            quantity=_cell(r.quantity),
+            reference_text=_cell(r.reference_text),
+        )  # fmt: skip
+        for r in rows
+    ]
     out = [
         "| check | quantity | reference | fidelity | level | fegear | ratio | command |",
         "|---|---|---|---|---|---|---|---|",
