@@ -697,6 +697,7 @@ def run(
     level: int | None = None,
     workers: int | None = None,
     backend: str | None = None,
+    root_stress: bool | None = None,
     study: Sequence[int] | None = None,
     progress: Progress | None = None,
     notify: Callable[[str], None] | None = None,
@@ -719,6 +720,10 @@ def run(
         per core); the result does not depend on it. Ignored by the Hertz scene.
     backend
         Sparse direct solver ``"auto"``, ``"pardiso"``, ``"superlu"``; overrides the case's.
+    root_stress
+        Gear pairs at ``fe``/``hybrid``: compute the tooth root stress (the sectors remeshed
+        with refined fillets and solved once more per member: on the seed face gear about
+        1-2 min and 8 GB more); overrides ``[analysis] root_stress`` (default False).
     study
         Hertz scene: levels of a mesh-convergence study (overrides ``[study] levels``).
     progress
@@ -743,6 +748,8 @@ def run(
         The analysis failed (mesh, solver).
     """
     if isinstance(case, HertzCase):
+        if root_stress:
+            raise InputError("root_stress", root_stress, "absent for the Hertz scene (no teeth)")
         return _run_hertz(case, fidelity, level, backend, study, progress)
     if not isinstance(case, GearCase):
         raise InputError("case", type(case).__name__, "a case from fegear.load_case")
@@ -758,6 +765,10 @@ def run(
         if backend not in ("auto", "pardiso", "superlu"):
             raise InputError("backend", backend, "'auto', 'pardiso' or 'superlu'")
         case = replace(case, backend=backend)
+    if root_stress is not None:
+        if not isinstance(root_stress, bool):
+            raise InputError("root_stress", root_stress, "True or False")
+        case = replace(case, root_stress=root_stress)
     fid = case.fidelity if fidelity is None else fidelity
     lvl = case.level if level is None else level
     if fid not in FIDELITIES:

@@ -81,6 +81,14 @@ def _parser() -> argparse.ArgumentParser:
         help="gear pairs: processes solving the mesh positions (default: one per core); the "
         "result does not depend on it",
     )
+    r.add_argument(
+        "--root-stress",
+        action="store_true",
+        default=None,
+        help="gear pairs at fe/hybrid: also the tooth root stress (the sectors remeshed with "
+        "refined fillets, one more factorisation per member: minutes and GB on large "
+        "sectors); overrides the case's [analysis] root_stress",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     s = sub.add_parser(
         "sweep",
@@ -232,6 +240,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         level=args.level,
         workers=args.workers,
         backend=args.backend,
+        root_stress=args.root_stress,
         progress=progress,
         notify=warn,
     )

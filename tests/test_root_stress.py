@@ -183,7 +183,7 @@ def test_face_gear_and_bevel_summaries_carry_root_stress(case, tmp_path):
     """The face gear and the spiral bevel as shipped (hybrid level 0): root stress per tooth and
     position in ``summary.json``, the cycle maxima, the plot and the VTK fields."""
     out = tmp_path / "out"
-    assert main(["run", str(REPO / "cases" / case), "--out", str(out), "-q"]) == 0
+    assert main(["run", str(REPO / "cases" / case), "--out", str(out), "-q", "--root-stress"]) == 0
     doc = json.loads((out / "summary.json").read_text())
     c = doc["cycle"]
     assert c["root_stress_max_equilibrium_residual"] < 1e-9  # a direct solve: round-off
@@ -197,3 +197,15 @@ def test_face_gear_and_bevel_summaries_carry_root_stress(case, tmp_path):
 
     pd = meshio.read(out / "vtk" / "gear_000.vtu").point_data
     assert "von_mises_MPa" in pd and "max_principal_stress_MPa" in pd
+
+
+def test_root_stress_is_off_by_default_and_says_so(tmp_path):
+    """Without ``--root-stress`` the run does not remesh the sectors: the summary's root stress
+    is null with the reason and the switch, not a coarse-sector stress (the contact sectors'
+    fillets are as coarse as their level)."""
+    out = tmp_path / "out"
+    assert main(["run", str(REPO / "cases" / "fzg_spur.toml"), "--out", str(out), "-q"]) == 0
+    c = json.loads((out / "summary.json").read_text())["cycle"]
+    assert c["root_stress_max_MPa"] is None
+    assert "--root-stress" in c["root_stress_reason"]
+    assert not (out / "root_stress.png").exists()

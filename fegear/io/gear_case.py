@@ -30,6 +30,7 @@ from fegear.geometry.face_gear import FaceGearDesign
 from fegear.geometry.involute import InvoluteDesign
 from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
 from fegear.io.schema import (
+    BOOLEAN,
     INT_PAIR,
     INTEGER,
     NUMBER,
@@ -385,6 +386,13 @@ ANALYSIS = Section(
             default="auto",
             choices=("auto", "pardiso", "superlu"),
         ),
+        Key(
+            "root_stress",
+            BOOLEAN,
+            "tooth root stress (fe, hybrid): the sectors remeshed with refined fillets, one "
+            "more sparse factorisation per member (seed face gear: about 1-2 min, 8 GB)",
+            default=False,
+        ),
     ),
 )
 MATERIAL = Section(
@@ -446,7 +454,7 @@ class GearCase:
         ``"pinion_torque_Nm"``) and ``load_value`` its value.
     errors
         Installation errors.
-    fidelity, level, n_positions, n_teeth, backend
+    fidelity, level, n_positions, n_teeth, backend, root_stress
         Analysis settings (``[analysis]``).
     E_MPa, nu
         Material of both members.
@@ -468,6 +476,7 @@ class GearCase:
     n_positions: int = 25
     n_teeth: int | None = None
     backend: str = "auto"
+    root_stress: bool = False
     E_MPa: float = 206000.0
     nu: float = 0.3
     speed_rpm: float | None = None
@@ -494,6 +503,7 @@ class GearCase:
             "level": self.level,
             "n_positions": self.n_positions,
             "backend": self.backend,
+            "root_stress": self.root_stress,
         }
         if self.n_teeth is not None:
             analysis["n_teeth"] = self.n_teeth
@@ -513,7 +523,8 @@ class GearCase:
         ----------
         **changes
             Fields of the case: ``name``, ``description``, ``fidelity``, ``level``,
-            ``n_positions``, ``n_teeth`` (None: automatic), ``backend``, ``E_MPa``, ``nu``,
+            ``n_positions``, ``n_teeth`` (None: automatic), ``backend``, ``root_stress``,
+            ``E_MPa``, ``nu``,
             ``speed_rpm`` (rpm, recorded only), ``errors`` (an
             :class:`~fegear.assembly.InstallationErrors` or a mapping of the ``[errors]`` keys:
             it replaces all of them, the ones not given are 0), ``pair`` (the whole ``[pair]``
@@ -617,6 +628,7 @@ class GearCase:
                 "n_positions": self.n_positions,
                 "n_teeth": self.n_teeth,
                 "backend": self.backend,
+                "root_stress": self.root_stress,
             },
             "material": {"E_MPa": self.E_MPa, "nu": self.nu},
         }
@@ -631,6 +643,7 @@ _REPLACE_KEYS = {
     "n_positions": ("analysis", "n_positions"),
     "n_teeth": ("analysis", "n_teeth"),
     "backend": ("analysis", "backend"),
+    "root_stress": ("analysis", "root_stress"),
     "E_MPa": ("material", "E_MPa"),
     "nu": ("material", "nu"),
     "speed_rpm": ("load", "speed_rpm"),
@@ -730,6 +743,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     n_pos = analysis_s.value(ana, "n_positions")
     n_teeth = analysis_s.value(ana, "n_teeth")
     backend = analysis_s.value(ana, "backend")
+    root_stress = analysis_s.value(ana, "root_stress")
     E = float(material_s.value(mat, "E_MPa"))
     nu = float(material_s.value(mat, "nu"))
     try:
@@ -749,6 +763,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         n_positions=int(n_pos),
         n_teeth=None if n_teeth is None else int(n_teeth),
         backend=backend,
+        root_stress=root_stress,
         E_MPa=E,
         nu=nu,
         speed_rpm=float(load["speed_rpm"]) if "speed_rpm" in load else None,

@@ -275,11 +275,15 @@ def _root_stress_cycle(run: GearRun) -> dict[str, Any]:
     ``cycle.root_stress_fillet_mm``, ``cycle.root_stress_max_equilibrium_residual``; null with
     ``cycle.root_stress_reason`` where the fidelity has no cell loads."""
     if not run.members or not any(mf.root for mf in run.members):
-        why = (
-            "the hertz fidelity has no contact cells: no loads on the sector FE"
-            if run.fidelity == "hertz"
-            else "no loaded position"
-        )
+        if run.fidelity == "hertz":
+            why = "the hertz fidelity has no contact cells: no loads on the sector FE"
+        elif not run.case.root_stress:
+            why = (
+                "not computed: [analysis] root_stress = false (the default; --root-stress, "
+                "or root_stress=True in fegear.run, computes it)"
+            )
+        else:
+            why = "no loaded position"
         return {
             "root_stress_max_MPa": None,
             "root_stress_reason": why,

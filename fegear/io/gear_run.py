@@ -485,6 +485,7 @@ def displacements(
     fillet_modules: float | None = None,
     refine_teeth: dict[str, tuple[int, ...]] | None = None,
     keep_dofs: bool = False,
+    root_stress: bool = True,
 ) -> tuple[MemberField, ...]:
     """Displacement and stress of both stress sectors at every position: ``u = K⁻¹ P F``.
 
@@ -503,6 +504,9 @@ def displacements(
     ``refine_teeth``: ``{member: sector teeth}`` whose zone (and fillets) the stress sector
     refines (default: all the zone teeth; a refinement study refines the tooth it reads only);
     ``keep_dofs``: keep the P2 displacement and the body in the :class:`MemberField`.
+    ``root_stress`` False: the displacement on the contact sectors themselves (no remeshing, the
+    factorisation of a sector of the contact model's size), without stresses (the contact
+    sectors' fillets are as coarse as their level: their stresses are not the root stress).
     """
     from fegear.fem.stress import (
         CONTACT_CLEARANCE_MODULES,
@@ -531,7 +535,7 @@ def displacements(
         if refine_teeth is not None and name in refine_teeth and boxes:
             boxes = tuple(z for z in boxes if z.tooth in refine_teeth[name])
         t0 = time.perf_counter()
-        smodel = stress_sector(member, model, boxes, fm * module)
+        smodel = stress_sector(member, model, boxes, fm * module) if root_stress else model
         body = smodel.body
         nodal = body.scalar_basis.nodal_dofs[0]  # scalar DOF of each vertex
         vdofs = 3 * nodal[:, None] + np.arange(3)[None, :]
@@ -567,15 +571,17 @@ def displacements(
             )
             U = np.transpose(full[vdofs], (2, 0, 1))
         teeth = model.teeth if model.teeth is not None else None
-        regions = fillet_regions(smodel.sector, model.side, teeth)
-        rec = VertexStress(body.mesh.p.T, body.mesh.t.T, body.scalar_basis.element_dofs,
-                           body.E, body.nu)  # fmt: skip
+        regions = fillet_regions(smodel.sector, model.side, teeth) if root_stress else ()
+        rec = None
+        if root_stress:
+            rec = VertexStress(body.mesh.p.T, body.mesh.t.T, body.scalar_basis.element_dofs,
+                               body.E, body.nu)  # fmt: skip
         s_max, s_min, s_vm = (np.zeros((n_pos, n_v)) for _ in range(3))
         root: list[tuple[Any, ...]] = [() for _ in range(n_pos)]
         equil: list[Any] = [None] * n_pos
         fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
         pts = body.mesh.p.T
-        for i in loaded:
+        for i in loaded if root_stress else ():
             sig = rec(full[:, i])
             ps = principal_stresses(sig)
             s_max[i], s_min[i], s_vm[i] = ps[:, 2], ps[:, 0], von_mises(sig)
@@ -587,9 +593,9 @@ def displacements(
             )  # fmt: skip
             equil[i] = reactions(K, body.basis.doflocs, fixed, full[:, i], F[:, i])
         diag = smodel.sector.diagnostics
-        h_fil = float(diag.get("fillet_mm", fm * module))
+        h_fil = float(diag.get("fillet_mm", fm * module)) if root_stress else None
         note = ""
-        if h_fil > fm * module * (1.0 + 1e-9):
+        if h_fil is not None and h_fil > fm * module * (1.0 + 1e-9):
             note = (
                 f"{name}: fillet elements {h_fil:.3g} mm instead of {fm * module:.3g} mm "
                 f"({fm:g} m): {float(diag.get('fillet_area_mm2', 0.0)):.0f} mm² of refined "
@@ -598,9 +604,9 @@ def displacements(
                 "benchmarks/results/root_stress_refinement.md at that size"
             )
             log.warning(note)
-        log.info("%s: stress sector (fillets %.3g mm, %d tets), %d positions in %.2f s (%s)",
-                 name, h_fil, body.mesh.t.shape[1], n_pos, time.perf_counter() - t0,
-                 used)  # fmt: skip
+        log.info("%s: %s sector (fillets %s mm, %d tets), %d positions in %.2f s (%s)",
+                 name, "stress" if root_stress else "contact", h_fil, body.mesh.t.shape[1],
+                 n_pos, time.perf_counter() - t0, used)  # fmt: skip
         bnames = [b for b in body.mesh.boundaries if b.startswith(f"flank_{model.side}_")]
         facets = np.concatenate([body.mesh.boundaries[b] for b in bnames])
         flank_nodes = np.unique(body.mesh.facets[:, facets])
@@ -613,10 +619,10 @@ def displacements(
                 displacement=U,
                 placements=place,
                 solver=used,
-                max_principal=s_max,
-                min_principal=s_min,
-                von_mises=s_vm,
-                root=tuple(root),
+                max_principal=s_max if root_stress else None,
+                min_principal=s_min if root_stress else None,
+                von_mises=s_vm if root_stress else None,
+                root=tuple(root) if root_stress else (),
                 equilibrium=tuple(equil),
                 fillet_mm=h_fil,
                 fillet_note=note,
@@ -747,7 +753,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         return run
     t0 = time.perf_counter()
     say("displacements", None, None)
-    members = displacements(pair, asm, models, cycle, run.phi2)
+    members = displacements(pair, asm, models, cycle, run.phi2, root_stress=case.root_stress)
     seconds["displacements"] = time.perf_counter() - t0
     return GearRun(
         case=case,

@@ -27,6 +27,7 @@ from typing import Any
 from fegear.errors import InputError
 
 __all__ = [
+    "BOOLEAN",
     "INTEGER",
     "INT_LIST",
     "INT_PAIR",
@@ -46,11 +47,12 @@ __all__ = [
 NUMBER = "number"
 INTEGER = "integer"
 STRING = "string"
+BOOLEAN = "boolean"
 INT_PAIR = "int-pair"  # [pinion, gear] integers
 NUMBER_PAIR = "number-pair"  # two numbers
 NUMBER_OR_PAIR = "number-or-pair"  # a number for both members or [pinion, gear]
 INT_LIST = "int-list"  # a list of integers
-_TYPES = (NUMBER, INTEGER, STRING, INT_PAIR, NUMBER_PAIR, NUMBER_OR_PAIR, INT_LIST)
+_TYPES = (NUMBER, INTEGER, STRING, BOOLEAN, INT_PAIR, NUMBER_PAIR, NUMBER_OR_PAIR, INT_LIST)
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,7 @@ class Key:
     name
         The key as written in the file (units in the name: ``module_mm``).
     type
-        One of :data:`NUMBER`, :data:`INTEGER`, :data:`STRING`, :data:`INT_PAIR`,
+        One of :data:`NUMBER`, :data:`INTEGER`, :data:`STRING`, :data:`BOOLEAN`, :data:`INT_PAIR`,
         :data:`NUMBER_PAIR`, :data:`NUMBER_OR_PAIR`, :data:`INT_LIST`.
     doc
         One line of meaning (for the reference).
@@ -139,6 +141,10 @@ class Key:
             Naming ``fld``, the value and what is allowed.
         """
         t = self.type
+        if t == BOOLEAN:
+            if not isinstance(value, bool):
+                raise InputError(fld, value, "true or false")
+            return
         if t == STRING:
             if not isinstance(value, str):
                 raise InputError(fld, value, "a string")
@@ -182,6 +188,7 @@ class Key:
             NUMBER: "number",
             INTEGER: "integer",
             STRING: "string",
+            BOOLEAN: "boolean",
             INT_PAIR: f"[{', '.join(self.labels)}] integers",
             NUMBER_PAIR: f"[{', '.join(self.labels)}] numbers",
             NUMBER_OR_PAIR: f"number or [{', '.join(self.labels)}]",
