@@ -195,7 +195,14 @@ def details(rows: list[Row]) -> str:
     return "\n".join(out)
 
 
-def write(rows: list[Row], seconds: float, sections: tuple[str, ...]) -> None:
+def _times(section_seconds: dict[str, float]) -> str:
+    """``"12.0 min: hertz 110 s, fzg 74 s, ..."`` (the wall time of each section's last run)."""
+    parts = [f"{s} {section_seconds[s]:.0f} s" for s in SECTIONS if s in section_seconds]
+    total = sum(section_seconds.values()) / 60
+    return f"{total:.1f} min: " + ", ".join(parts) if parts else "not timed"
+
+
+def write(rows: list[Row], section_seconds: dict[str, float]) -> None:
     head = f"""# Validation
 
 Each row sets a fegear result against a reference computed without the solver: a closed form, a
@@ -205,8 +212,8 @@ standard (ISO 6336), or the design target the geometry was synthesized for. The 
 under `-m slow`) with its tolerance and the reason for it.
 
 This page is generated: `python docs/make_validation.py` runs every case below and rewrites it
-(this run: {seconds / 60:.1f} min for the sections {", ".join(sections)}, 2 cores; a section
-named on the command line is rerun alone, the other rows are kept from `docs/validation.json`).
+({_times(section_seconds)} on 2 cores, each section as last run; a section named on the command
+line is rerun alone, the other rows are kept from `docs/validation.json`).
 Ratio = fegear / reference; a trend row gives its values at the three loads and how much the
 quantity grew. The seconds under "Rows" are the wall time of each run with the artefact cache as
 this run found it (meshes and operators built once are read back later): not a benchmark.
@@ -227,7 +234,7 @@ def main(argv: list[str]) -> None:
     if argv == ["render"]:  # rewrite the page from docs/validation.json, no runs
         doc = json.loads(DATA.read_text(encoding="utf-8"))
         rows = [as_row(d) for s in SECTIONS for d in doc["sections"].get(s, [])]
-        write(rows, doc["seconds"], tuple(doc["ran"]))
+        write(rows, doc.get("section_seconds", {}))
         print(PAGE)
         return
     sections = tuple(argv) or SECTIONS
@@ -235,8 +242,10 @@ def main(argv: list[str]) -> None:
         if s not in SECTIONS:
             raise SystemExit(f"unknown section {s!r}: one of {', '.join(SECTIONS)}")
     old: dict[str, list[dict]] = {}
+    times: dict[str, float] = {}
     if DATA.exists() and set(sections) != set(SECTIONS):
-        old = json.loads(DATA.read_text(encoding="utf-8"))["sections"]
+        kept = json.loads(DATA.read_text(encoding="utf-8"))
+        old, times = kept["sections"], kept.get("section_seconds", {})
     t0 = time.perf_counter()
     new: dict[str, list[dict]] = {}
     for s in SECTIONS:
@@ -248,14 +257,15 @@ def main(argv: list[str]) -> None:
                 why = f"signal {-e.returncode}" if e.returncode < 0 else f"exit {e.returncode}"
                 log.warning("%s failed: %s", s, why)
                 new[s] = [asdict(_failed(s, f"{why} in `{' '.join(e.cmd[2:4])}`"))]
-            log.warning("%s: %.0f s", s, time.perf_counter() - t)
+            times[s] = time.perf_counter() - t
+            log.warning("%s: %.0f s", s, times[s])
         elif s in old:
             new[s] = old[s]
         seconds = time.perf_counter() - t0
-        doc = {"sections": new, "seconds": seconds, "ran": list(sections)}
+        doc = {"sections": new, "seconds": seconds, "ran": list(sections), "section_seconds": times}
         DATA.write_text(json.dumps(doc, indent=1), encoding="utf-8")  # kept if a later one fails
     rows = [as_row(d) for s in SECTIONS for d in new.get(s, [])]
-    write(rows, seconds, sections)
+    write(rows, times)
     print(PAGE)
 
 
