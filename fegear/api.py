@@ -36,7 +36,7 @@ from fegear.case import HertzCase
 from fegear.case import load_case as _load_case
 from fegear.errors import InputError
 from fegear.io.flank_view import PatternCentre
-from fegear.io.gear_case import FIDELITIES, N_LEVELS, GearCase
+from fegear.io.gear_case import ANALYSIS, FIDELITIES, N_LEVELS, GearCase
 
 __all__ = [
     "Checks",
@@ -638,8 +638,8 @@ def _run_hertz(
     from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
 
     n = len(CELLS_ACROSS_MINOR)
-    if backend not in (None, "auto", "pardiso", "superlu"):
-        raise InputError("backend", backend, "'auto', 'pardiso' or 'superlu'")
+    if backend is not None:
+        ANALYSIS.key("backend").check("backend", backend)  # the case file's rule
     if fidelity not in (None, "fe", "hybrid"):
         raise InputError("fidelity", fidelity, "'fe' or 'hybrid' for the Hertz scene")
     level = case.level if level is None else level
@@ -762,8 +762,7 @@ def run(
     if study is not None:
         raise InputError("study", study, "absent for a gear case (a Hertz-scene option)")
     if backend is not None:
-        if backend not in ("auto", "pardiso", "superlu"):
-            raise InputError("backend", backend, "'auto', 'pardiso' or 'superlu'")
+        ANALYSIS.key("backend").check("backend", backend)  # the case file's rule
         case = replace(case, backend=backend)
     if root_stress is not None:
         if not isinstance(root_stress, bool):

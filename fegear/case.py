@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from fegear.errors import InputError
-from fegear.io.gear_case import GearCase
+from fegear.io.gear_case import ANALYSIS, GearCase
 from fegear.io.schema import (
     INT_LIST,
     INTEGER,
@@ -120,13 +120,7 @@ SECTIONS: tuple[Section, ...] = (
     Section(
         "solver",
         (
-            Key(
-                "backend",
-                STRING,
-                "sparse direct solver",
-                default="auto",
-                choices=("auto", "pardiso", "superlu"),
-            ),
+            ANALYSIS.key("backend"),  # the same key as the gear cases
             Key("fidelity", STRING, "contact compliance", default="fe", choices=("fe", "hybrid")),
             Key("fe_level", INTEGER, "hybrid: the FE mesh level", default=0, range=_LEVEL),
         ),
