@@ -44,6 +44,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -54,7 +55,15 @@ from ..errors import DesignError, SolverError
 from .face_gear_fillet import FilletLimit, TipEdge
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, generate
 from .involute import InvoluteDesign, InvoluteMember
-from .surface import FlankBoundaries, FlankSurface, Side, finite_difference_curvatures
+from .surface import (
+    BlankOutline,
+    ConeLine,
+    FlankBoundaries,
+    FlankCoordinates,
+    FlankSurface,
+    Side,
+    finite_difference_curvatures,
+)
 from .transforms import rot_y, rot_z, translation
 from .validation import validate_face_gear
 
@@ -154,6 +163,7 @@ class FaceGearMember:
 
     design: FaceGearDesign
     name: str = "face_gear"
+    family: ClassVar[str] = "face_gear"
 
     @property
     def n_teeth(self) -> int:
@@ -414,6 +424,37 @@ class FaceGearMember:
             p[~f], n[~f] = env.points, env.normals
         p[f], n[f] = self._fillet_points(side, u[f], v[f])
         return p, n
+
+    def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
+        """Exact points and normals, fillet included (:meth:`point_normal`)."""
+        return self.point_normal(side, u, v)
+
+    def flank_coordinates(self, side: Side) -> FlankCoordinates:
+        """Working flank (:meth:`boundaries`, the same for both sides); Litvin's closed form
+        ``"face_gear_orthogonal"`` for a shaft angle of 90°."""
+        fast = "face_gear_orthogonal" if abs(self.design.shaft_angle_deg - 90.0) < 1e-12 else None
+        return FlankCoordinates(self.boundaries(), (1e-5, 1e-4), fast)
+
+    def blank_outline(self, rim_modules: float = 3.0) -> BlankOutline:
+        """Cone coordinates ``(L, h) = (ρ, z)``: tip and root planes, the blank's base
+        ``blank_thickness_mm`` below the root plane (``rim_modules`` does not apply); the face
+        from the inner to the outer radius, 13 sections."""
+        d = self.design
+        m = d.module_mm
+        bd = self.boundaries()
+        z_root = -d.dedendum_coeff * m
+        z_base = z_root - d.blank_thickness_mm
+        # the generated surface exists only inside the undercut limit L1 (~465 mm for the
+        # seed): extend the loft by 1 mm at both ends; 13 sections over the 91 mm keep the
+        # lofted flank within ~2 µm of the analytic one (7 sections: 7 µm)
+        return BlankOutline(
+            module=m, meridian=np.eye(2), tip=ConeLine(d.addendum_coeff * m, 0.0),
+            root=ConeLine(z_root, 0.0), bottom=ConeLine(z_base, 0.0),
+            L_start=d.inner_radius_mm, L_end=d.outer_radius_mm,
+            L_range=(d.inner_radius_mm - 1.0, d.outer_radius_mm + 1.0), n_sections=13,
+            u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side="drive",
+            bottom_name="base", has_fillet=True,
+        )  # fmt: skip
 
     def flank(
         self, side: Side, nu: int = 11, nv: int = 21, include_fillet: bool = False

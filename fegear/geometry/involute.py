@@ -26,13 +26,15 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import MeshError
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, Translation, generate
 from .generation import tool_sample as _tool_sample
-from .surface import FlankBoundaries, FlankSurface, Side
+from .surface import BlankOutline, ConeLine, FlankBoundaries, FlankCoordinates, FlankSurface, Side
 from .transforms import rot_z, translation
 
 __all__ = ["InvoluteDesign", "InvoluteMember", "RackCutter", "involute_function"]
@@ -182,6 +184,7 @@ class InvoluteMember:
 
     design: InvoluteDesign
     name: str = "gear"
+    family: ClassVar[str] = "involute"
 
     @property
     def n_teeth(self) -> int:
@@ -295,6 +298,50 @@ class InvoluteMember:
             u_name="rack profile arc length u (mm)",
             v_name="axial position z (mm)",
         )
+
+    def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
+        """Exact points and normals, fillet included (:meth:`point_normal`)."""
+        return self.point_normal(side, u, v)
+
+    def flank_coordinates(self, side: Side) -> FlankCoordinates:
+        """Working flank of ``side``; the closed-form involute ``"spur_involute"`` for an
+        unmodified spur member (no helix, crowning or relief)."""
+        d = self.design
+        plain = (
+            d.helix_angle_deg == 0.0
+            and d.profile_crowning_mm == 0.0
+            and d.lead_crowning_mm == 0.0
+            and d.tip_relief_mm == 0.0
+        )
+        return FlankCoordinates(
+            self.boundaries(side), (1e-5, 1e-5), "spur_involute" if plain else None
+        )
+
+    def blank_outline(self, rim_modules: float = 3.0) -> BlankOutline:
+        """Cone coordinates ``(L, h) = (z, ρ)``: tip and root cylinders, a bore of radius
+        ``r_f − rim_modules · m``; the face ``∓b/2``, 2 sections for a spur member (they are
+        translates), 7 for a helical one.
+
+        Raises
+        ------
+        MeshError
+            If the rim leaves no bore (``r_bore <= 0.1 r_f``).
+        """
+        d = self.design
+        m = d.module_mm
+        bd = self.boundaries("drive")
+        b = d.face_width_mm
+        n_sec = 7 if d.helix_angle_deg != 0.0 else 2
+        r_bore = self.r_f - rim_modules * m
+        if r_bore <= 0.1 * self.r_f:
+            raise MeshError(f"rim of {rim_modules} modules leaves no bore (r_bore = {r_bore:.2f})")
+        return BlankOutline(
+            module=m, meridian=np.array([[0.0, 1.0], [1.0, 0.0]]), tip=ConeLine(self.r_a, 0.0),
+            root=ConeLine(self.r_f, 0.0), bottom=ConeLine(r_bore, 0.0), L_start=-b / 2,
+            L_end=b / 2, L_range=(-b / 2 - 0.3 * m, b / 2 + 0.3 * m), n_sections=n_sec,
+            u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side="drive",
+            bottom_name="bore", has_fillet=True,
+        )  # fmt: skip
 
     def flank(
         self, side: Side, nu: int = 21, nv: int = 11, include_fillet: bool = True

@@ -36,7 +36,12 @@ __all__ = [
     "Side",
     "FlankBoundaries",
     "FlankSurface",
+    "ConeLine",
+    "BlankOutline",
+    "FlankCoordinates",
     "GeneratedMember",
+    "NativeFlankEvaluator",
+    "HasNativeFlank",
     "principal_curvatures",
     "curvatures_from_normal_derivatives",
     "finite_difference_curvatures",
@@ -200,16 +205,115 @@ class FlankSurface:
         return (len(self.u), len(self.v))
 
 
+@dataclass(frozen=True)
+class ConeLine:
+    """A surface of revolution ``h = a + b L`` in a member's cone coordinates ``(L, h)``
+    (:class:`BlankOutline`): a cylinder, a plane or a cone about the member axis."""
+
+    a: float
+    b: float
+
+    def __call__(self, L: Array | float) -> Array:
+        return self.a + self.b * np.asarray(L, dtype=float)
+
+
+@dataclass(frozen=True)
+class BlankOutline:
+    """The blank of a member in its meridian plane, and how its flanks sit on it (mm, rad).
+
+    A plain geometric description that any consumer (the sector mesher, the engagement checks,
+    plots) reads instead of asking which family a member is.
+
+    Attributes
+    ----------
+    module
+        The member's module (mm): the length scale of its teeth.
+    meridian
+        ``(2, 2)`` orthogonal ``M`` mapping the member's *cone coordinates* ``(L, h)`` to
+        ``(ρ, z)``: ``(ρ, z)ᵀ = M (L, h)ᵀ``. ``L`` runs along the face and is the flank
+        coordinate ``v`` (``z`` of a cylindrical gear, the radius of a face gear, the cone
+        distance of a bevel gear); ``h`` runs across it (radius, height ``z``, height above the
+        pitch cone). The sections ``L = const`` are planes, cylinders or back cones.
+    tip, root, bottom
+        Tip surface, root surface, and the bottom of the blank (the face the member is held by)
+        as :class:`ConeLine` ``h = a + b L``.
+    L_start, L_end
+        The face: ``L`` of its two ends (toe/heel, inner/outer radius, ``∓b/2``).
+    L_range
+        A face span a little wider than ``L_start … L_end`` over which the flank and fillet
+        surfaces still evaluate (a solid built on it is trimmed back to the face).
+    n_sections
+        Sections ``L = const`` spread evenly over ``L_range`` through which a surface lofted
+        from exact section curves follows the flanks to a few µm.
+    u_root, u_fillet, u_tip
+        The flank's profile limits in flank coordinates (as :class:`FlankBoundaries`; the same
+        numbers for both sides).
+    plus_side
+        The side (``"drive"``/``"coast"``) facing +θ about the axis, the other faces −θ.
+    bottom_name
+        Name of the bottom face (``"bore"``, ``"base"``).
+    has_fillet
+        The fillet is generated (:meth:`GeneratedMember.flank_points` evaluates it for
+        ``u_root <= u < u_fillet``).
+    n_fillet
+        Exact points that represent one tooth-space half of root and fillet in a section.
+    """
+
+    module: float
+    meridian: Array
+    tip: ConeLine
+    root: ConeLine
+    bottom: ConeLine
+    L_start: float
+    L_end: float
+    L_range: tuple[float, float]
+    n_sections: int
+    u_root: float
+    u_fillet: float
+    u_tip: float
+    plus_side: Side
+    bottom_name: str
+    has_fillet: bool
+    n_fillet: int = 25
+
+
+@dataclass(frozen=True)
+class FlankCoordinates:
+    """How a member's flank is addressed in flank coordinates ``(u, v)``.
+
+    Attributes
+    ----------
+    bounds
+        The working flank: ``u`` from ``u_fillet`` to ``u_tip``, ``v`` over the face.
+    step
+        Finite-difference steps ``(du, dv)`` suited to the scales of ``u`` and ``v`` (for
+        Jacobians and curvatures by differences of :meth:`GeneratedMember.point_normal`).
+    fast_evaluator
+        Name of a cheaper exact evaluation of the *same* surface that the family offers (a
+        closed form, or a native parametrisation): ``"spur_involute"``,
+        ``"face_gear_orthogonal"``, ``"spiral_bevel_native"``. Consumers that know the name
+        may use it; ``None`` (or a name they do not know): :meth:`GeneratedMember.point_normal`.
+    """
+
+    bounds: FlankBoundaries
+    step: tuple[float, float]
+    fast_evaluator: str | None = None
+
+
 @runtime_checkable
 class GeneratedMember(Protocol):
-    """What every gear family implements.
+    """What every gear family implements, and all that the consumers (TCA, mesh) may ask.
 
     Member frame: rotation axis = ``z`` through the origin; the tooth space / tooth of index 0 is
     placed as the family documents; tooth ``k`` is tooth 0 turned by ``k * tooth_angle`` about z.
+
+    A new family is one class with these members (``family`` a class attribute naming it); no
+    consumer names a family. Optional capability: ``native_flank(side)`` (:class:`HasNativeFlank`).
     """
 
     name: str
     n_teeth: int
+    family: str
 
     @property
     def tooth_angle(self) -> float:
@@ -228,6 +332,42 @@ class GeneratedMember(Protocol):
     def point_normal(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
         """Exact surface points ``(..., 3)`` and outward unit normals at arbitrary ``(u, v)``."""
         ...
+
+    def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
+        """The fastest exact points and normals the family has at flank coordinates ``(u, v)``,
+        the fillet (``u < u_fillet``) included: the surfaces of :meth:`point_normal` (to
+        ~1e-12 mm), or :meth:`point_normal` itself."""
+        ...
+
+    def flank_coordinates(self, side: Side) -> FlankCoordinates:
+        """Working-flank bounds, difference steps and fast evaluator of the ``side`` flank."""
+        ...
+
+    def blank_outline(self, rim_modules: float = 3.0) -> BlankOutline:
+        """The blank's meridian outline; ``rim_modules``: rim below the root (modules) where the
+        family's blank is not fixed by its design data."""
+        ...
+
+
+@runtime_checkable
+class NativeFlankEvaluator(Protocol):
+    """An exact evaluator of a flank in native parameters ``(a, b)`` with exact tangents."""
+
+    def native(self, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
+        """Native parameters of flank coordinates."""
+        ...
+
+    def evaluate(self, a: ArrayLike, b: ArrayLike, tangents: bool = False) -> tuple[Array, ...]:
+        """``(p, n)``, with ``tangents`` also ``(∂p/∂a, ∂p/∂b)``."""
+        ...
+
+
+@runtime_checkable
+class HasNativeFlank(Protocol):
+    """Optional member capability: :class:`NativeFlankEvaluator` per side (closest points in
+    parameters that extend past the flank limits, with exact tangents)."""
+
+    def native_flank(self, side: Side) -> NativeFlankEvaluator: ...
 
 
 def _symmetric_eig2(S: Array) -> tuple[Array, Array]:

@@ -21,9 +21,13 @@ member, everything that construction needs, in the member frame (axis z):
   (:func:`section_integral_volume`), and closest points on the analytic flank
   (:func:`flank_distance`).
 
-Spiral bevel flanks and fillets are evaluated with the member's exact native evaluators
-(:meth:`~fegear.geometry.spiral_bevel.SpiralBevelMember.flank_points`: the blade's and the edge
-radius's envelopes, the same surfaces to ~1e-13 mm, ~100× faster than ``point_normal``).
+The family-specific data come from the member through its protocol
+(:class:`~fegear.geometry.surface.GeneratedMember`): the blank outline
+(:meth:`~fegear.geometry.surface.GeneratedMember.blank_outline`: cone coordinates, tip, root and
+bottom lines, face, sections, parameter limits, plus side) and the fastest exact flank and fillet
+points (``flank_points``; the spiral bevel's native evaluators, the blade's and the edge radius's
+envelopes, are the same surfaces to ~1e-13 mm, ~100× faster than ``point_normal``). This module
+names no family: a new one meshes once its member implements the protocol.
 
 Teeth of the sector are numbered ``j = 0 … n−1`` in the direction of +θ; sector tooth ``j`` is
 member tooth ``k = j − n//2`` (tooth ``k`` is tooth 0 turned by ``k τ`` about z), so the centre
@@ -35,16 +39,13 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import MeshError
-from ..geometry.face_gear import FaceGearMember
-from ..geometry.involute import InvoluteMember
-from ..geometry.spiral_bevel import SpiralBevelMember
-from ..geometry.surface import GeneratedMember, Side
+from ..geometry.surface import ConeLine, GeneratedMember, HasNativeFlank, Side
 
 __all__ = [
     "Line",
@@ -63,15 +64,9 @@ log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
 
-@dataclass(frozen=True)
-class Line:
-    """A surface of revolution ``h = a + b L`` in cone coordinates."""
-
-    a: float
-    b: float
-
-    def __call__(self, L: Array | float) -> Array:
-        return self.a + self.b * np.asarray(L, dtype=float)
+Line = ConeLine
+"""A surface of revolution ``h = a + b L`` in cone coordinates (the geometry's
+:class:`~fegear.geometry.surface.ConeLine`)."""
 
 
 @dataclass(frozen=True)
@@ -99,9 +94,11 @@ def _rotate(p: Array, ang: Array | float) -> Array:
 class SectorFrame:
     """Family-specific data of a sector (see module docstring). Lengths mm, angles rad.
 
-    ``L_range`` is the face span of the loft (a little wider than ``L_start … L_end``, which the
-    envelope trims exactly); ``n_sections`` section wires are spread evenly over it; each half of a
-    tooth space's root and fillet is one section edge through ``n_fillet`` exact points
+    The member's :class:`~fegear.geometry.surface.BlankOutline` (its fields, under the same
+    names), with the member, its ``family`` name and the bottom of the loft. ``L_range`` is the
+    face span of the loft (a little wider than ``L_start … L_end``, which the envelope trims
+    exactly); ``n_sections`` section wires are spread evenly over it; each half of a tooth
+    space's root and fillet is one section edge through ``n_fillet`` exact points
     (:func:`_root_fillet`).
     """
 
@@ -169,9 +166,7 @@ class SectorFrame:
     # ---------------------------------------------------------------- flanks
     def flank_points(self, side: Side, u: Array, v: Array) -> Array:
         """Exact flank points ``(..., 3)`` of member tooth 0 at ``(u, v)`` (broadcast)."""
-        if isinstance(self.member, SpiralBevelMember):
-            return self.member.flank_points(side, u, v)[0]
-        return self.member.point_normal(side, u, v)[0]
+        return self.member.flank_points(side, u, v)[0]
 
     def tooth_points(self, side: Side, k: Array | int, u: Array, v: Array) -> Array:
         """Exact flank points of member teeth ``k`` (broadcast ``k``, ``u``, ``v``)."""
@@ -188,84 +183,28 @@ def _unit(v: Array) -> Array:
 
 
 def sector_frame(member: GeneratedMember, rim_modules: float = 3.0) -> SectorFrame:
-    """The :class:`SectorFrame` of a member of any supported family.
+    """The :class:`SectorFrame` of a member of any family (a
+    :class:`~fegear.geometry.surface.GeneratedMember`): its
+    :meth:`~fegear.geometry.surface.GeneratedMember.blank_outline` and a loft bottom half a
+    module below the blank's bottom (trimmed away by the envelope).
 
-    Rims: involute members get a bore of radius ``r_f − rim_modules · m``; the face gear its
-    blank (``blank_thickness_mm`` below the root plane, bottom face ``base``); spiral bevel
-    members a rim of ``rim_modules · m`` below the root cone (its bottom cone is ``bore``).
+    Rims (the families' outlines): involute members get a bore of radius
+    ``r_f − rim_modules · m``; the face gear its blank (``blank_thickness_mm`` below the root
+    plane, bottom face ``base``); spiral bevel members a rim of ``rim_modules · m`` below the root
+    cone (its bottom cone is ``bore``).
     """
-    if isinstance(member, InvoluteMember):
-        d = member.design
-        m = d.module_mm
-        bd = member.boundaries("drive")
-        b = d.face_width_mm
-        n_sec = 7 if d.helix_angle_deg != 0.0 else 2
-        r_bore = member.r_f - rim_modules * m
-        if r_bore <= 0.1 * member.r_f:
-            raise MeshError(f"rim of {rim_modules} modules leaves no bore (r_bore = {r_bore:.2f})")
-        return SectorFrame(
-            member=member, family="involute", module=m,
-            meridian=np.array([[0.0, 1.0], [1.0, 0.0]]), tip=Line(member.r_a, 0.0),
-            root=Line(member.r_f, 0.0), bottom=Line(r_bore, 0.0),
-            loft_bottom=Line(r_bore - 0.5 * m, 0.0), L_start=-b / 2, L_end=b / 2,
-            L_range=(-b / 2 - 0.3 * m, b / 2 + 0.3 * m), n_sections=n_sec,
-            u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side="drive",
-            bottom_name="bore", has_fillet=True,
-        )  # fmt: skip
-    if isinstance(member, FaceGearMember):
-        d = member.design
-        m = d.module_mm
-        bd = member.boundaries()
-        z_root = -d.dedendum_coeff * m
-        z_base = z_root - d.blank_thickness_mm
-        # the generated surface exists only inside the undercut limit L1 (~465 mm for the
-        # seed): extend the loft by 1 mm at both ends; 13 sections over the 91 mm keep the
-        # lofted flank within ~2 µm of the analytic one (7 sections: 7 µm)
-        return SectorFrame(
-            member=member, family="face_gear", module=m, meridian=np.eye(2),
-            tip=Line(d.addendum_coeff * m, 0.0), root=Line(z_root, 0.0),
-            bottom=Line(z_base, 0.0), loft_bottom=Line(z_base - 0.5 * m, 0.0),
-            L_start=d.inner_radius_mm, L_end=d.outer_radius_mm,
-            L_range=(d.inner_radius_mm - 1.0, d.outer_radius_mm + 1.0), n_sections=13,
-            u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side="drive",
-            bottom_name="base", has_fillet=True,
-        )  # fmt: skip
-    if isinstance(member, SpiralBevelMember):
-        bl = member.blank
-        i = member.index
-        m = bl.module_mm
-        gam = member.pitch_angle
-        A0 = bl.outer_cone_distance
-        F = bl.face_width_mm
-        ded = bl.dedenda[i - 1]
-        td = math.tan(bl.dedendum_angles[i - 1])
-        tj = math.tan(bl.dedendum_angles[1 if i == 1 else 0])
-        root = Line(-ded + A0 * td, -td)
-        tip = Line(bl.addenda[i - 1] - A0 * tj, tj)
-        bot = Line(root.a - rim_modules * m, root.b)
-        # plus side: the side whose mean point has the larger polar angle (one exact envelope
-        # point per side, 15 ms; building a side's native evaluator for it took 0.8 s, for the
-        # unloaded side on every warm run)
-        ang = {}
-        for s in ("drive", "coast"):
-            um, vm = member.mean_parameters(s)
-            p = member.point_normal(s, np.array([um]), np.array([vm]))[0][0]
-            ang[s] = math.atan2(p[1], p[0])
-        plus: Side = "drive" if ang["drive"] > ang["coast"] else "coast"
-        bd = member.boundaries()
-        sg, cg = math.sin(gam), math.cos(gam)
-        # root + fillet of a space half (~1.5 mm) through 13 exact points: fillet nodes within
-        # 2e-5 of the element size (25 points: 3e-6, but OCC's intersection of the lofted
-        # sector with its envelope took 1.8x as long: 6.9 s instead of 3.8 s, 5-tooth pinion)
-        return SectorFrame(
-            member=member, family="spiral_bevel", module=m,
-            meridian=np.array([[sg, cg], [cg, -sg]]), tip=tip, root=root, bottom=bot,
-            loft_bottom=Line(bot.a - 0.5 * m, bot.b), L_start=A0 - F, L_end=A0,
-            L_range=(A0 - F - 0.04 * F, A0 + 0.04 * F), n_sections=9,
-            u_root=bd.u_root, u_fillet=bd.u_fillet, u_tip=bd.u_tip, plus_side=plus,
-            bottom_name="bore", has_fillet=True, n_fillet=13,
-        )  # fmt: skip
-    raise MeshError(f"no sector geometry for member type {type(member).__name__}")
+    if not isinstance(member, GeneratedMember):
+        raise MeshError(
+            f"no sector geometry for member type {type(member).__name__}: "
+            "it does not implement GeneratedMember"
+        )
+    o = member.blank_outline(rim_modules)
+    return SectorFrame(
+        member=member,
+        family=member.family,
+        loft_bottom=Line(o.bottom.a - 0.5 * o.module, o.bottom.b),
+        **{f.name: getattr(o, f.name) for f in fields(o)},
+    )
 
 
 def _polar(p: Array) -> Array:
@@ -487,9 +426,10 @@ def flank_distance(
     (scalar or ``(m,)``).
 
     Closest-point Gauss-Newton on ``|p(a, b) − x|²`` from the nearest point of an
-    ``n_grid × n_grid`` sample of the flank. Spiral bevel: in the cutter parameters
-    ``(a, b) = (s, θ)`` with the exact tangents of the native evaluator, unbounded; other
-    families: in ``(u, v)`` with finite-difference tangents, ``u`` projected onto the working
+    ``n_grid × n_grid`` sample of the flank. A member with a native flank evaluator
+    (:class:`~fegear.geometry.surface.HasNativeFlank`; the spiral bevel): in its native
+    parameters (the bevel's cutter parameters ``(s, θ)``) with its exact tangents, unbounded;
+    other members: in ``(u, v)`` with finite-difference tangents, ``u`` projected onto the working
     flank ``[u_fillet, u_tip]`` (below it the parameters run onto the fillet). Returns the distances
     ``(m,)`` mm and the parameters ``(m, 2)``.
     """
@@ -500,7 +440,7 @@ def flank_distance(
     ug = np.linspace(fr.u_fillet, fr.u_tip, n_grid)
     vg = np.linspace(fr.L_start, fr.L_end, n_grid)
     U, V = np.meshgrid(ug, vg, indexing="ij")
-    if isinstance(fr.member, SpiralBevelMember):
+    if isinstance(fr.member, HasNativeFlank):
         nf = fr.member.native_flank(side)
         S, T = nf.native(U, V)
         G = nf.evaluate(S, T)[0].reshape(-1, 3)

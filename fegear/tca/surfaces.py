@@ -23,6 +23,12 @@ coordinates* ``(u, v)`` (profile × face, with :class:`~fegear.geometry.surface.
 
 Jacobians of the Newton solves are finite differences of these exact evaluators (the residuals
 are exact, so the converged points are exact; the Jacobian only sets the convergence rate).
+
+:func:`flank_map` names no family: the member says, in its
+:meth:`~fegear.geometry.surface.GeneratedMember.flank_coordinates`, which fast exact evaluator
+its surface has (if any); :data:`FAST_FLANK_MAPS` turns the name into one of the maps above. A
+member without one (a new family) gets :class:`GenericFlankMap` with no edit here; a fast map for
+it is an acceleration, added by registering its class under the name the member gives.
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..geometry.surface import FlankBoundaries
+from ..geometry.surface import FlankBoundaries, GeneratedMember
 
 __all__ = [
     "FlankMap",
@@ -40,6 +46,7 @@ __all__ = [
     "SpurInvoluteMap",
     "FaceGearMap",
     "SpiralBevelMap",
+    "FAST_FLANK_MAPS",
     "flank_map",
 ]
 
@@ -263,35 +270,27 @@ class SpiralBevelMap(FlankMap):
         return lo.copy(), hi.copy()
 
 
-def flank_map(member, side: str, generic: bool = False) -> FlankMap:
+FAST_FLANK_MAPS: dict[str, tuple[type[FlankMap], tuple[float, float]]] = {
+    "spur_involute": (SpurInvoluteMap, (1e-7, 1e-5)),
+    "face_gear_orthogonal": (FaceGearMap, (1e-7, 1e-8)),
+    # steps of the finite-difference curvatures (ellipse): 50 steps = 0.01 mm, 1e-3 rad
+    "spiral_bevel_native": (SpiralBevelMap, (2e-4, 2e-5)),
+}
+"""Fast exact flank maps by the name a member's ``flank_coordinates(side).fast_evaluator``
+gives: the map class and its finite-difference steps in its native parameters."""
+
+
+def flank_map(member: GeneratedMember, side: str, generic: bool = False) -> FlankMap:
     """The fastest exact :class:`FlankMap` for ``member``/``side`` (``generic`` forces the engine).
 
-    Working-flank bounds: ``u`` from the fillet limit to the tip, ``v`` over the face.
+    Working-flank bounds (``member.flank_coordinates(side).bounds``): ``u`` from the fillet
+    limit to the tip, ``v`` over the face. The fast map is the one :data:`FAST_FLANK_MAPS`
+    registers under the member's ``fast_evaluator``; otherwise, or with ``generic``,
+    :class:`GenericFlankMap` with the member's steps.
     """
-    from ..geometry.face_gear import FaceGearMember
-    from ..geometry.involute import InvoluteMember
-
-    if isinstance(member, FaceGearMember):
-        bd = member.boundaries()
-        if not generic and abs(member.design.shaft_angle_deg - 90.0) < 1e-12:
-            return FaceGearMap(member, side, bd, (1e-7, 1e-8))
-        return GenericFlankMap(member, side, bd, (1e-5, 1e-4))
-    if isinstance(member, InvoluteMember):
-        bd = member.boundaries(side)
-        d = member.design
-        plain = (
-            d.helix_angle_deg == 0.0
-            and d.profile_crowning_mm == 0.0
-            and d.lead_crowning_mm == 0.0
-            and d.tip_relief_mm == 0.0
-        )
-        if plain and not generic:
-            return SpurInvoluteMap(member, side, bd, (1e-7, 1e-5))
-        return GenericFlankMap(member, side, bd, (1e-5, 1e-5))
-    from ..geometry.spiral_bevel import SpiralBevelMember
-
-    if isinstance(member, SpiralBevelMember) and not generic:
-        # steps of the finite-difference curvatures (ellipse): 50 steps = 0.01 mm, 1e-3 rad
-        return SpiralBevelMap(member, side, member.boundaries(side), (2e-4, 2e-5))
-    bd = member.boundaries()
-    return GenericFlankMap(member, side, bd, (1e-6, 1e-5))
+    fc = member.flank_coordinates(side)
+    fast = None if generic or fc.fast_evaluator is None else FAST_FLANK_MAPS.get(fc.fast_evaluator)
+    if fast is not None:
+        cls, step = fast
+        return cls(member, side, fc.bounds, step)
+    return GenericFlankMap(member, side, fc.bounds, fc.step)
