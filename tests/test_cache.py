@@ -20,7 +20,7 @@ import platformdirs
 import pytest
 
 from fegear.cli import main
-from fegear.mesh import cache as fcache
+from fegear.store import cache as fcache
 
 REPO = Path(__file__).resolve().parents[1]
 FZG = REPO / "cases" / "fzg_spur.toml"
@@ -115,8 +115,11 @@ def test_main_job_from_two_folders_shares_one_cache(monkeypatch, tmp_path):
 
 
 def _fill(kind: str, n: int) -> None:
+    made_by = fcache.Producer(("fegear.store",))  # test kinds: not in fcache.PRODUCERS
     for i in range(n):
-        fcache.cached_file(kind, {"i": i}, ".bin", lambda p, i=i: p.write_bytes(b"x" * (i + 1)))
+        fcache.cached_file(
+            kind, {"i": i}, ".bin", lambda p, i=i: p.write_bytes(b"x" * (i + 1)), made_by
+        )
 
 
 def test_cache_info_and_clear(monkeypatch, tmp_path, capsys):

@@ -30,7 +30,7 @@ def private_cache(tmp_path, monkeypatch):
 def _same(a, b) -> None:
     assert len(a) == len(b)
     for p, q in zip(a, b, strict=True):
-        assert p.phi1 == q.phi1 and p.te_rad == q.te_rad  # bit-identical: a pickle round trip
+        assert p.phi1 == q.phi1 and p.te_rad == q.te_rad  # bit-identical: a JSON + npz round trip
         np.testing.assert_array_equal(p.points, q.points)
         assert len(p.grids) == len(q.grids)
         for g, h in zip(p.grids, q.grids, strict=True):
@@ -48,7 +48,7 @@ def test_hit_returns_what_a_fresh_tca_computes(private_cache) -> None:
     assert second.tca.asm.phase2 == fresh_asm.phase2
     _same(second.positions, fresh)
     _same(first.positions, fresh)
-    assert len(list((private_cache / "tca").glob("*.pkl"))) == 1
+    assert len(list((private_cache / "tca").glob("*.json"))) == 1
 
 
 @pytest.mark.parametrize(
@@ -65,4 +65,4 @@ def test_a_changed_input_is_a_miss(private_cache, change) -> None:
     asm = involute_assembly(PINION, GEAR, change.get("errors", base))
     again = cached_tca(PINION, GEAR, asm, change.get("options", OPT), change.get("phi1", PHI1))
     assert not again.cache_hit
-    assert len(list((private_cache / "tca").glob("*.pkl"))) == 2
+    assert len(list((private_cache / "tca").glob("*.json"))) == 2

@@ -57,7 +57,6 @@ with the same slope; it enters the cache key only when given, so the contact mes
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import time
@@ -72,7 +71,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError, MeshError
 from ..geometry.surface import GeneratedMember, Side
-from .cache import cache_dir, cached_file, content_hash
+from ..store.cache import Entry, cached_record
 from .gmsh_session import initialize as initialize_gmsh
 from .gmsh_session import native_output_to_log
 from .sector_geometry import (
@@ -108,9 +107,6 @@ COARSE = (1.6, 1.3, 1.0, 0.8, 0.6)
 #: size; the seed face gear's 89 mm wide fillets at 0.635 mm made 127 000-149 000 tetrahedra and
 #: a 14 GB solve (killed on a 23 GB machine).
 FILLET_TRIANGLES = 5000
-#: 6: generated spiral-bevel fillet; 5: generated face-gear fillet; 4: flat surface triangles
-#: re-meshed; 3: zone seeds interpolated
-_VERSION = "sector-6"
 
 
 class FlankZone(NamedTuple):
@@ -655,7 +651,6 @@ def sector_mesh(
         if not 0 <= z.tooth < n_teeth:
             raise InputError("mesh.zone.tooth", z.tooth, f"in 0..{n_teeth - 1}")
     params = {
-        "version": _VERSION,
         "member": repr(member),
         "family": fr.family,
         "n_teeth": n_teeth,
@@ -670,15 +665,22 @@ def sector_mesh(
             raise InputError("mesh.fillet_mm", fillet_mm, "a finite size > 0 (mm)")
         params["fillet_mm"] = float(fillet_mm)
         params["fillet_triangles"] = FILLET_TRIANGLES
-    side_path = cache_dir("mesh") / f"{content_hash(params)}.json"
-    diag_box: dict[str, object] = {}
 
-    def build(tmp: Path) -> None:
-        diag_box.update(_build(fr, n_teeth, level, zone, algorithm, min_sicn, tmp, fillet_mm))
-        side_path.write_text(json.dumps(diag_box, indent=1))
+    # the entry (fegear.store.cache.cached_record): the .msh, then the JSON of the diagnostics
+    # that makes it valid; the key holds the code of fegear.mesh and fegear.geometry and gmsh's
+    # version (fegear.store.cache.PRODUCERS["mesh"])
+    def build(entry: Entry) -> dict[str, object]:
+        diag: dict[str, object] = {}
 
-    path, hit = cached_file("mesh", params, ".msh", build)
-    diag = json.loads(side_path.read_text()) if side_path.exists() else {}
+        def write(tmp: Path) -> None:
+            diag.update(_build(fr, n_teeth, level, zone, algorithm, min_sicn, tmp, fillet_mm))
+
+        entry.write(".msh", write)
+        return diag
+
+    entry, record, hit = cached_record("mesh", params, build)
+    path = entry.path(".msh")
+    diag = dict(record)
     diag["cache_hit"] = hit
     public = {k: v for k, v in params.items() if k != "member"}
     public["member_name"] = getattr(member, "name", "")
@@ -694,7 +696,7 @@ def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray
     ``$Entities`` section; the arrays are kept next to it in ``<name>.arrays.npz`` (10 ms to read;
     written atomically, re-made if older than the ``.msh``).
     """
-    from fegear.io.files import atomic_write
+    from fegear.store.files import atomic_write
 
     side = path.with_name(path.stem + ".arrays.npz")
     if side.exists() and side.stat().st_mtime >= path.stat().st_mtime:

@@ -6,21 +6,24 @@ pinion angles, not on the torque or the FE model. A loaded analysis on the same 
 torque, another fidelity or mesh level, a re-run) reads it back instead of solving it again
 (measured on the seed face gear, 25 positions: 2.9 s -> 0.01 s).
 
-The key holds the members' ``repr`` (their complete design data, as for the sector meshes),
-the assembly's fields, the options, the angles and a hash of the source of the geometry and TCA
-packages, so a change of the code that produces the positions invalidates the entry by itself.
-The entry is a pickle of the phase, the :class:`~fegear.tca.results.PositionResult` tuple and
-the TCA's precomputed state (:meth:`~fegear.tca.TCA.state`); it is written atomically
-(:func:`fegear.mesh.cache.cached_file`) and only ever read by the same code version.
+The key (:func:`fegear.store.cache.artefact_key`) holds the members' ``repr`` (their complete
+design data, as for the sector meshes), the assembly's fields, the options and the angles, with
+the code version of the TCA's producer (the source of ``fegear.tca``, ``fegear.geometry``,
+``fegear.assembly`` and ``fegear.hertz``) and the numpy and scipy versions
+(:data:`fegear.store.cache.PRODUCERS`), so a change of the code that produces the positions
+invalidates the entry by itself.
+
+The entry (:func:`fegear.store.cache.cached_record`) is plain data, no pickle: a ``.npz`` of the
+arrays (read with ``allow_pickle=False``) and the JSON record, written last, of the phase, the
+:class:`~fegear.tca.results.PositionResult` tuple and the TCA's precomputed state
+(:meth:`~fegear.tca.TCA.state_record`) with their numbers (:func:`~fegear.tca.results.to_record`:
+a float is written by its ``repr``, so a hit gives back the positions bit for bit).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
-import hashlib
 import logging
-import pickle
 from pathlib import Path
 from typing import NamedTuple
 
@@ -29,9 +32,9 @@ import numpy as np
 from ..assembly import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
-from .results import PositionResult
+from .results import PositionResult, from_record, to_record
 
-__all__ = ["CachedTCA", "cached_tca"]
+__all__ = ["CachedTCA", "cached_tca", "load_arrays", "save_arrays"]
 
 log = logging.getLogger(__name__)
 
@@ -44,23 +47,55 @@ class CachedTCA(NamedTuple):
     cache_hit: bool
 
 
-@functools.lru_cache(maxsize=1)
-def _source_hash() -> str:
-    """SHA-256 of the source of the packages that produce the positions."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for pkg in ("geometry", "tca"):
-        for f in sorted((root / pkg).glob("*.py")):
-            h.update(f.name.encode())
-            h.update(f.read_bytes())
-    for f in ("assembly.py", "hertz.py"):
-        h.update((root / f).read_bytes())
-    return h.hexdigest()[:20]
-
-
 def _assembly_key(asm: Assembly) -> dict[str, object]:
     """The assembly's data fields (its ``nominal`` builder is a callable, rebuilt from them)."""
     return {f.name: getattr(asm, f.name) for f in dataclasses.fields(asm) if f.name != "nominal"}
+
+
+def pair_key(pinion, gear, assembly: Assembly, options: TCAOptions) -> dict[str, object]:
+    """The content of the pair's TCA artefacts (``tca``, ``contact_path``, ``handover``): the
+    members' ``repr``, the assembly's fields and the options."""
+    return {
+        "pinion": repr(pinion),
+        "gear": repr(gear),
+        "assembly": _assembly_key(assembly),
+        "options": options,
+    }
+
+
+def save_arrays(path: Path, arrays: dict[str, np.ndarray]) -> dict[str, list]:
+    """Write ``arrays`` at ``path`` as an uncompressed ``.npz`` of one flat array per dtype (a
+    TCA of 25 positions has ~1000 small arrays: one ``.npz`` member each would take 0.15 s to
+    read); returns the index ``{name: [member, offset, shape]}`` that :func:`load_arrays` needs
+    (kept in the entry's JSON record)."""
+    members: dict[str, str] = {}  # dtype.str -> member name
+    parts: dict[str, list[np.ndarray]] = {}
+    sizes: dict[str, int] = {}
+    index: dict[str, list] = {}
+    for name, arr in arrays.items():
+        arr = np.asarray(arr)
+        if arr.dtype.kind not in "biuf":
+            raise TypeError(f"array {name!r}: dtype {arr.dtype} (numbers or booleans only)")
+        member = members.setdefault(arr.dtype.str, f"a{len(members)}")
+        index[name] = [member, sizes.get(member, 0), list(arr.shape)]
+        sizes[member] = sizes.get(member, 0) + arr.size
+        parts.setdefault(member, []).append(arr.ravel())
+    blobs = {m: np.concatenate(p) for m, p in parts.items()}
+    with open(path, "wb") as fh:
+        np.savez(fh, **blobs)
+    return index
+
+
+def load_arrays(path: Path, index: dict[str, list]) -> dict[str, np.ndarray]:
+    """The arrays of :func:`save_arrays` (``index`` is what it returned), read without pickles:
+    each a copy of its slice of the flat arrays, with its dtype and shape."""
+    with np.load(path, allow_pickle=False) as z:
+        blobs = {m: z[m] for m in z.files}
+    out = {}
+    for name, (member, offset, shape) in index.items():
+        size = int(np.prod(shape, dtype=np.int64))
+        out[name] = blobs[member][offset : offset + size].reshape(shape).copy()
+    return out
 
 
 def cached_tca(
@@ -72,33 +107,34 @@ def cached_tca(
     Returns the :class:`~fegear.tca.TCA` of the phased assembly (the loaded analysis evaluates
     its flank maps) and the positions.
     """
-    from fegear.mesh.cache import cached_file
+    from fegear.store.cache import cached_record
 
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
-    params = {
-        "pinion": repr(pinion),
-        "gear": repr(gear),
-        "assembly": _assembly_key(assembly),
-        "options": repr(options),
-        "phi1": phi1,
-        "source": _source_hash(),
-    }
+    params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, object] = {}
 
-    def build(path: Path) -> None:
+    def build(entry) -> dict[str, object]:
         asm = assembly.with_phase2(reference_phase(pinion, gear, assembly, options))
         tca = TCA(pinion, gear, asm, options)
         positions = tuple(tca.positions(phi1))
         box["tca"], box["positions"] = tca, positions
-        with open(path, "wb") as fh:
-            entry = (float(asm.phase2), positions, tca.state())
-            pickle.dump(entry, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        arrays: dict[str, np.ndarray] = {}
+        record = {
+            "phase2": float(asm.phase2),
+            "positions": to_record(positions, arrays, "positions"),
+            "state": to_record(tca.state_record(), arrays, "state"),
+        }
+        index: dict[str, list] = {}
+        entry.write(".npz", lambda tmp: index.update(save_arrays(tmp, arrays)))  # data first
+        return {**record, "arrays": index}
 
-    path, hit = cached_file("tca", params, ".pkl", build)
+    entry, record, hit = cached_record("tca", params, build)
     if not hit:
         return CachedTCA(box["tca"], box["positions"], False)  # type: ignore[arg-type]
-    with open(path, "rb") as fh:
-        phase2, positions, state = pickle.load(fh)
-    tca = TCA.restore(state, assembly.with_phase2(phase2))
-    log.info("TCA positions read from the cache (%d)", len(positions))
-    return CachedTCA(tca, tuple(positions), True)
+    arrays = load_arrays(entry.path(".npz"), record["arrays"])
+    positions = from_record(record["positions"], arrays)
+    state = from_record(record["state"], arrays)
+    asm = assembly.with_phase2(float(record["phase2"]))
+    tca = TCA.from_state_record(state, pinion, gear, asm, options)  # type: ignore[arg-type]
+    log.info("TCA positions read from the cache (%d)", len(positions))  # type: ignore[arg-type]
+    return CachedTCA(tca, tuple(positions), True)  # type: ignore[arg-type]

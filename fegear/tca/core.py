@@ -189,20 +189,68 @@ class TCA:
         self.Es = effective_modulus(o.E_MPa, o.nu, o.E_MPa, o.nu)
 
     # ------------------------------------------------------------------ cache support
-    def state(self) -> dict:
-        """What the constructor precomputed, without the assembly (its error-free builder is a
-        closure): with :meth:`restore` the on-disk TCA cache skips the flank-map evaluations of
-        the constructor (0.4 s on the face gear, whose flank is an envelope solved point by
-        point)."""
-        return {k: v for k, v in self.__dict__.items() if k != "asm"}
+    #: Constructor attributes of :meth:`state_record`: arrays and numbers kept as they are.
+    _STATE_DATA = (
+        "pairs", "su", "sv", "sa", "sb", "sP", "sN", "step1", "ga", "gb", "_gscale", "et",
+        "edge_names", "cell_uv", "cP", "cN", "cA", "Es",
+    )  # fmt: skip
+    #: Attributes rebuilt by :meth:`from_state_record` from its arguments (or on first use).
+    _STATE_REBUILT = ("opt", "asm", "pinion", "gear", "fm1", "fm2", "_gear_interp")
+
+    def state_record(self) -> dict[str, object]:
+        """What the constructor precomputed, as plain data (arrays, numbers, strings, tuples):
+        with :meth:`from_state_record` the on-disk TCA cache (:mod:`fegear.tca.cached`) skips
+        the flank-map evaluations of the constructor (0.4 s on the face gear, whose flank is an
+        envelope solved point by point) without pickling objects.
+
+        The members, options, assembly and flank maps are not in it (the caller gives them
+        back); the gear-sample tree is its points (the tree is rebuilt from them, as the
+        constructor builds it); each gear-edge spline is its breakpoints and coefficients.
+
+        Raises
+        ------
+        TypeError
+            An attribute without a record form (a new constructor attribute must be added to
+            :attr:`_STATE_DATA` or rebuilt by :meth:`from_state_record`).
+        """
+        unknown = set(self.__dict__) - set(self._STATE_DATA) - set(self._STATE_REBUILT)
+        unknown -= {"gtree", "edges"}
+        if unknown:
+            raise TypeError(f"TCA.state_record: no record form for {sorted(unknown)}")
+        out: dict[str, object] = {
+            k: self.__dict__[k] for k in self._STATE_DATA if k in self.__dict__
+        }
+        out["gtree"] = np.asarray(self.gtree.data)
+        out["edges"] = [
+            [{"x": s.x, "c": s.c, "extrapolate": bool(s.extrapolate), "axis": int(s.axis)}
+             for s in edge]
+            for edge in self.edges
+        ]  # fmt: skip
+        return out
 
     @classmethod
-    def restore(cls, state: dict, assembly: Assembly) -> TCA:
-        """A TCA from :meth:`state` of one built on the same members and options, placed by
-        ``assembly``."""
+    def from_state_record(
+        cls, state: dict[str, object], pinion, gear, assembly: Assembly, options: TCAOptions
+    ) -> TCA:
+        """A TCA from :meth:`state_record` of one built on ``pinion``, ``gear`` (same sides) and
+        ``options``, placed by ``assembly``: the same object as the constructor's (flank maps
+        made again by :func:`.surfaces.flank_map`, which evaluates nothing)."""
         tca = cls.__new__(cls)
-        tca.__dict__.update(state)
+        tca.opt = options
         tca.asm = assembly
+        tca.pinion, tca.gear = pinion, gear
+        tca.fm1, tca.fm2 = flank_map(pinion, assembly.side1), flank_map(gear, assembly.side2)
+        for k in cls._STATE_DATA:
+            if k in state:
+                setattr(tca, k, state[k])
+        tca.gtree = cKDTree(state["gtree"])
+        tca.edges = [
+            tuple(
+                CubicSpline.construct_fast(s["c"], s["x"], s["extrapolate"], s["axis"])
+                for s in edge
+            )
+            for edge in state["edges"]
+        ]
         return tca
 
     @cached_property

@@ -268,18 +268,11 @@ def cached_handover(pinion, gear, assembly, options, tca, n_samples: int = 48) -
     (FZG 0.3-1.5 s, seed face gear ~1 s, spiral bevel ~2 s otherwise)."""
     import json
 
-    from fegear.mesh.cache import cached_file
+    from fegear.store.cache import cached_file
 
-    from .cached import _assembly_key, _source_hash
+    from .cached import pair_key
 
-    params = {
-        "pinion": repr(pinion),
-        "gear": repr(gear),
-        "assembly": _assembly_key(assembly),
-        "options": repr(options),
-        "n_samples": n_samples,
-        "source": _source_hash(),
-    }
+    params = {**pair_key(pinion, gear, assembly, options), "n_samples": n_samples}
     box: dict[str, Handover] = {}
 
     def build(path) -> None:

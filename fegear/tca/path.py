@@ -220,18 +220,12 @@ def cached_contact_path(pinion, gear, assembly, options, tca: TCA, positions) ->
     """:func:`contact_path` of the pair, read from the artefact cache when the same pair
     (members, assembly with its errors, TCA options, the positions' angles) was traced before
     (seed face gear ~1.8 s otherwise)."""
-    from fegear.mesh.cache import cached_file
+    from fegear.store.cache import cached_file
 
-    from .cached import _assembly_key, _source_hash
+    from .cached import pair_key
 
-    params = {
-        "pinion": repr(pinion),
-        "gear": repr(gear),
-        "assembly": _assembly_key(assembly),
-        "options": repr(options),
-        "phi1": np.array([p.phi1 for p in positions], dtype=float),
-        "source": _source_hash(),
-    }
+    phi1 = np.array([p.phi1 for p in positions], dtype=float)
+    params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, ContactPath | None] = {}
     arrays = ("phi", "gear_points", "pinion_points", "fixed_points", "gear_uv", "pinion_uv")
 
@@ -252,7 +246,7 @@ def cached_contact_path(pinion, gear, assembly, options, tca: TCA, positions) ->
     path, hit = cached_file("contact_path", params, ".npz", build)
     if not hit:
         return box["cp"]
-    with np.load(path) as z:
+    with np.load(path, allow_pickle=False) as z:
         if bool(z["none"]):
             return None
         s, lim = z["scalars"], z["limits"]

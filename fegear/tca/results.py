@@ -9,6 +9,8 @@ masked by a boolean array next to them.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,7 +18,15 @@ from numpy.typing import NDArray
 
 from ..hertz import HertzPoint
 
-__all__ = ["SeparationGrid", "ContactEllipseAt", "PositionResult", "CycleResult", "ARCSEC"]
+__all__ = [
+    "SeparationGrid",
+    "ContactEllipseAt",
+    "PositionResult",
+    "CycleResult",
+    "ARCSEC",
+    "from_record",
+    "to_record",
+]
 
 Array = NDArray[np.float64]
 #: one arcsecond in rad
@@ -235,3 +245,72 @@ class CycleResult:
     def te_peak_to_peak_arcsec(self) -> float:
         te = self.te_arcsec[self.has_contact]
         return float(te.max() - te.min()) if te.size else 0.0
+
+
+# ------------------------------------------------------------------ plain-data records
+#: The classes a record (:func:`to_record`) may hold, by name.
+_RECORD_CLASSES = {
+    c.__name__: c for c in (PositionResult, SeparationGrid, ContactEllipseAt, HertzPoint)
+}
+
+
+def to_record(obj: object, arrays: dict[str, np.ndarray], key: str) -> object:
+    """``obj`` as plain JSON data, its arrays put in ``arrays`` (for ``np.savez``), for the
+    on-disk TCA cache (:mod:`fegear.tca.cached`): no pickle, and :func:`from_record` gives back
+    an equal object bit for bit.
+
+    Handles ``None``, ``bool``, ``int``, ``float`` (JSON writes a float by its ``repr``, which
+    reads back exactly), ``str``; numpy arrays of numbers or booleans and numpy scalars (stored
+    in ``arrays`` under names starting with ``key``, dtype and shape kept); tuples and lists;
+    dicts with ``str`` keys; the result dataclasses of this module and
+    :class:`~fegear.hertz.HertzPoint`.
+
+    Raises
+    ------
+    TypeError
+        Anything else (naming its type and ``key``).
+    """
+    if obj is None or type(obj) in (bool, int, float, str):
+        return obj
+    if isinstance(obj, (np.ndarray, np.generic)):
+        arr = np.asarray(obj)
+        if arr.dtype.kind not in "biuf":
+            raise TypeError(f"TCA record: {key} has dtype {arr.dtype} (numbers or booleans only)")
+        if key in arrays:
+            raise ValueError(f"TCA record: two arrays named {key!r}")
+        arrays[key] = arr
+        return {"npz": key, "scalar": isinstance(obj, np.generic)}
+    if isinstance(obj, tuple):
+        return {"tuple": [to_record(v, arrays, f"{key}.{i}") for i, v in enumerate(obj)]}
+    if isinstance(obj, list):
+        return [to_record(v, arrays, f"{key}.{i}") for i, v in enumerate(obj)]
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
+        return {"dict": {k: to_record(v, arrays, f"{key}.{k}") for k, v in obj.items()}}
+    cls = type(obj)
+    if _RECORD_CLASSES.get(cls.__name__) is cls:
+        fields = {
+            f.name: to_record(getattr(obj, f.name), arrays, f"{key}.{f.name}")
+            for f in dataclasses.fields(obj)
+        }
+        return {"dataclass": cls.__name__, "fields": fields}
+    raise TypeError(f"TCA record: {key} is a {cls.__module__}.{cls.__qualname__}")
+
+
+def from_record(doc: object, arrays: Mapping[str, np.ndarray]) -> object:
+    """The object of :func:`to_record` (``arrays``: its arrays, e.g. an ``np.load`` of them)."""
+    if doc is None or isinstance(doc, (bool, int, float, str)):
+        return doc
+    if isinstance(doc, list):
+        return [from_record(v, arrays) for v in doc]
+    if isinstance(doc, dict):
+        if "npz" in doc:
+            arr = arrays[doc["npz"]]
+            return arr[()] if doc["scalar"] else arr
+        if "tuple" in doc:
+            return tuple(from_record(v, arrays) for v in doc["tuple"])
+        if "dict" in doc:
+            return {k: from_record(v, arrays) for k, v in doc["dict"].items()}
+        if "dataclass" in doc:
+            cls = _RECORD_CLASSES[doc["dataclass"]]
+            return cls(**{k: from_record(v, arrays) for k, v in doc["fields"].items()})
+    raise ValueError(f"TCA record: not a record: {str(doc)[:80]}")

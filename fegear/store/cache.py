@@ -1,0 +1,711 @@
+"""Content-hash cache of expensive artefacts (meshes, compliance operators, TCA, …).
+
+**One key rule.** An artefact is stored under ``<cache root>/<kind>/<key>.<suffix>``; the key
+(:func:`artefact_key`) is the SHA-256 of a canonical JSON (:func:`content_hash`) of
+
+- ``kind``: the kind of artefact (the folder);
+- ``params``: the content it is made from (geometry, mesh parameters, material, boundary
+  conditions, options, …), canonicalised by :func:`canonical`, which refuses any object it does
+  not know instead of falling back on its ``repr``;
+- ``code``: the code version of its producer, :func:`code_hash` of the source files of the
+  fegear packages and modules that produce the kind (:data:`PRODUCERS`);
+- ``deps``: the versions of the third-party distributions that produce it
+  (:func:`dependency_versions`, e.g. gmsh for the meshes).
+
+A change of any of them is a new key, so nothing is ever invalidated by hand (no version strings
+to bump). Every kind declares its producer in :data:`PRODUCERS`; a kind without one is refused.
+
+**No pickles.** An artefact is one file written by its producer (:func:`cached_file`: ``.npy``,
+``.npz`` loaded without pickles, ``.msh``, ``.json``), or a *record* (:func:`cached_record`): data
+files plus a JSON document (``<key>.json``) that is written last and lists them.
+
+**Atomic writes.** Every file is written to a temporary name in the same folder and renamed into
+place (:func:`fegear.store.files.atomic_write`), so an interrupted run never leaves a half-written
+file; a record is trusted only when its JSON exists and every data file it lists is there, so an
+entry whose writing was cut short is a miss, rebuilt by the next run.
+
+The root (:func:`cache_root`) is ``$FEGEAR_CACHE`` if set, else the per-user cache folder of the
+platform (``platformdirs.user_cache_dir("fegear")``: ``~/.cache/fegear`` on Linux,
+``~/Library/Caches/fegear`` on macOS, ``%LOCALAPPDATA%\\fegear\\Cache`` on Windows), so runs from
+any working directory share one cache.
+
+The root holds a ``CACHEDIR.TAG`` (the Cache Directory Tagging convention: backup tools skip the
+folder) that also marks it as a fegear cache: :func:`clear_cache` refuses to delete anything in a
+folder without it (a folder of an older fegear, made before the tag, is recognised by its layout:
+only kind folders of content-hash files).
+
+Every lookup is counted (:func:`record_cache_use`), so a caller can tell a warm run from a cold
+one by what it read, not by its timing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import functools
+import hashlib
+import importlib.metadata
+import json
+import logging
+import os
+import re
+import shutil
+from collections import Counter
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+
+from fegear.errors import InputError
+from fegear.store.files import atomic_write
+
+__all__ = [
+    "CACHE_TAG",
+    "PRODUCERS",
+    "CacheInfo",
+    "CacheUse",
+    "Entry",
+    "KindInfo",
+    "Producer",
+    "artefact_key",
+    "cache_dir",
+    "cache_info",
+    "cache_root",
+    "cached_file",
+    "cached_record",
+    "canonical",
+    "RECORD_SUFFIX",
+    "clear_cache",
+    "code_hash",
+    "content_hash",
+    "dependency_versions",
+    "is_cache_folder",
+    "record_cache_use",
+]
+
+log = logging.getLogger(__name__)
+
+#: Name of the tag file at the cache root.
+CACHE_TAG = "CACHEDIR.TAG"
+_TAG_TEXT = (
+    "Signature: 8a477f597d28d172789f06886806bc55\n"
+    "# This file is a cache directory tag created by fegear (mesh and operator cache).\n"
+    "# For information about cache directory tags see https://bford.info/cachedir/\n"
+)
+_SIGNATURE = "Signature: 8a477f597d28d172789f06886806bc55"
+_KIND = re.compile(r"^[a-z][a-z0-9_]*$")
+#: An artefact (``<20 hex>.<suffix>``) or the temporary file of an interrupted write
+#: (``.<20 hex>.<random>.<suffix>``, :func:`fegear.store.files.atomic_write`).
+_ARTEFACT = re.compile(r"^\.?[0-9a-f]{20}(\.[A-Za-z0-9_]+)*$")
+
+
+def cache_root() -> Path:
+    """The cache root: ``$FEGEAR_CACHE`` if set (and not empty), else the per-user cache folder
+    of the platform. Not created here."""
+    env = os.environ.get("FEGEAR_CACHE", "").strip()
+    if env:
+        return Path(env).expanduser()
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("fegear", appauthor=False))
+
+
+def _tag(root: Path) -> None:
+    tag = root / CACHE_TAG
+    if not tag.exists():
+        try:
+            atomic_write(tag, lambda p: p.write_text(_TAG_TEXT, encoding="utf-8"))
+        except OSError as exc:  # a read-only cache still serves hits
+            log.warning("cannot write %s: %s", tag, exc)
+
+
+def cache_dir(kind: str) -> Path:
+    """The folder holding artefacts of one kind (created, with the root's tag, if missing)."""
+    if not _KIND.match(kind):
+        raise InputError("kind", kind, "a cache kind of lower-case letters, digits and '_'")
+    root = cache_root()
+    path = root / kind
+    path.mkdir(parents=True, exist_ok=True)
+    _tag(root)
+    return path
+
+
+# --------------------------------------------------------------------------------------------
+# The key rule: content + code version + dependency versions
+# --------------------------------------------------------------------------------------------
+
+
+def canonical(obj: object) -> object:
+    """``obj`` as plain JSON data, the same for equal content (the hashed form of a key).
+
+    Known: ``None``, ``bool``, ``int``, ``float``, ``str``; numpy scalars (as the Python number);
+    lists and tuples (as lists); mappings with ``str`` keys (sorted by key); numpy arrays of
+    numbers or booleans (their dtype, shape and the SHA-256 of their bytes); dataclass instances
+    (their class name and the fields that take part in their equality, ``compare=True``).
+
+    Raises
+    ------
+    TypeError
+        Anything else (naming its type and where it sits): an object is never hashed by its
+        ``repr``, which may be partial (numpy abbreviates long arrays) or hold an address.
+    """
+    return _canonical(obj, "params")
+
+
+def _canonical(obj: object, where: str) -> object:
+    if obj is None or isinstance(obj, (bool, str)):
+        return obj
+    if type(obj) in (int, float):
+        return obj
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating):
+        return float(obj)
+    if isinstance(obj, Mapping):
+        out = {}
+        for k, v in obj.items():
+            if not isinstance(k, str):
+                raise TypeError(
+                    f"cache key: {where} has a key of type {type(k).__qualname__} ({k!r}); "
+                    "only str keys are hashed"
+                )
+            out[k] = _canonical(v, f"{where}[{k!r}]")
+        return dict(sorted(out.items()))
+    if isinstance(obj, (list, tuple)):
+        return [_canonical(v, f"{where}[{i}]") for i, v in enumerate(obj)]
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind not in "biuf":
+            raise TypeError(
+                f"cache key: {where} is an array of dtype {obj.dtype}; only arrays of numbers "
+                "or booleans are hashed"
+            )
+        return {
+            "__array__": hashlib.sha256(np.ascontiguousarray(obj).tobytes()).hexdigest(),
+            "shape": list(obj.shape),
+            "dtype": str(obj.dtype),
+        }
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        fields = {
+            f.name: _canonical(getattr(obj, f.name), f"{where}.{f.name}")
+            for f in dataclasses.fields(obj)
+            if f.compare
+        }
+        return {"__dataclass__": type(obj).__qualname__, **fields}
+    raise TypeError(
+        f"cache key: {where} is a {type(obj).__module__}.{type(obj).__qualname__}, which the "
+        "cache cannot hash (numbers, str, bool, None, lists, tuples, str-keyed mappings, numpy "
+        "arrays and scalars, dataclasses)"
+    )
+
+
+def content_hash(params: Mapping[str, object]) -> str:
+    """SHA-256 (hex, 20 characters) of the canonical JSON (:func:`canonical`) of ``params``.
+
+    Raises
+    ------
+    TypeError
+        ``params`` holds an object :func:`canonical` does not know.
+    """
+    text = json.dumps(_canonical(params, "params"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+#: The folder of the fegear package (the source files :func:`code_hash` reads).
+_FEGEAR = Path(__file__).resolve().parents[1]
+
+
+def _sources(module: str) -> list[Path]:
+    """The source files of a fegear package (every ``.py`` below it) or module."""
+    parts = module.split(".")
+    if parts[0] != "fegear" or len(parts) < 2 or not all(p.isidentifier() for p in parts):
+        raise ValueError(f"code_hash: {module!r} is not a fegear package or module")
+    base = _FEGEAR.joinpath(*parts[1:])
+    if base.is_dir():
+        return sorted(base.rglob("*.py"))
+    if base.with_suffix(".py").is_file():
+        return [base.with_suffix(".py")]
+    raise ValueError(f"code_hash: no package or module {module} in {_FEGEAR}")
+
+
+@functools.cache
+def _code_hash(modules: tuple[str, ...]) -> str:
+    files = sorted({f for m in modules for f in _sources(m)})
+    h = hashlib.sha256()
+    for f in files:
+        h.update(f.relative_to(_FEGEAR).as_posix().encode())
+        h.update(b"\0")
+        h.update(f.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()[:20]
+
+
+def code_hash(*modules: str) -> str:
+    """SHA-256 (hex, 20 characters) of the source files of the fegear packages and modules
+    ``modules`` (``"fegear.mesh"``: every ``.py`` below ``fegear/mesh``; ``"fegear.hertz"``:
+    ``fegear/hertz.py``), read once per process. The code version of an artefact: any change of
+    the code that produces it changes its key."""
+    return _code_hash(tuple(sorted(set(modules))))
+
+
+@functools.cache
+def _version(dist: str) -> str | None:
+    try:
+        return importlib.metadata.version(dist)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def dependency_versions(*dists: str) -> dict[str, str | None]:
+    """``{distribution: installed version}`` (None: not installed) of third-party packages, by
+    their distribution names (``"gmsh"``, ``"scikit-fem"``), read once per process."""
+    return {d: _version(d) for d in sorted(set(dists))}
+
+
+@dataclass(frozen=True)
+class Producer:
+    """What produces a kind of artefact: its key holds the code version of ``code`` and the
+    versions of ``deps``.
+
+    Attributes
+    ----------
+    code
+        fegear packages and modules whose source produces the artefact (:func:`code_hash`).
+    deps
+        Third-party distributions whose code produces it (:func:`dependency_versions`).
+    """
+
+    code: tuple[str, ...]
+    deps: tuple[str, ...] = ()
+
+
+_MESH_CODE = ("fegear.mesh", "fegear.geometry")
+_MESH_DEPS = ("gmsh", "meshio", "numpy", "scipy")
+_FE_DEPS = (*_MESH_DEPS, "scikit-fem")
+_TCA_CODE = ("fegear.tca", "fegear.geometry", "fegear.assembly", "fegear.hertz")
+_TCA = Producer(_TCA_CODE, ("numpy", "scipy"))
+
+#: The producer of every kind of artefact (a kind not listed here cannot be cached).
+PRODUCERS: Mapping[str, Producer] = MappingProxyType(
+    {
+        # sector meshes (fegear.mesh.sector) and the Hertz scene's bodies (fegear.mesh.hertz_bodies)
+        "mesh": Producer(_MESH_CODE, _MESH_DEPS),
+        # the flank operators (fegear.compliance.candidate_operator) of a meshed body
+        "compliance": Producer(
+            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.compliance"), _FE_DEPS
+        ),
+        # the tetrahedra below a flank (fegear.ltca.model)
+        "layer": Producer((*_MESH_CODE, "fegear.ltca.model"), _FE_DEPS),
+        # the unloaded TCA (fegear.tca.cached), its path of contact and its hand-over check
+        "tca": _TCA,
+        "contact_path": _TCA,
+        "handover": _TCA,
+        # the synthesized spiral bevel pair (fegear.pipeline.pair)
+        "bevel_pair": Producer(("fegear.geometry",), ("numpy", "scipy")),
+    }
+)
+
+
+def _producer(kind: str, producer: Producer | None) -> Producer:
+    if producer is not None:
+        return producer
+    try:
+        return PRODUCERS[kind]
+    except KeyError:
+        raise ValueError(
+            f"cache kind {kind!r} has no producer (fegear.store.cache.PRODUCERS: "
+            f"{sorted(PRODUCERS)})"
+        ) from None
+
+
+def artefact_key(kind: str, params: Mapping[str, object], producer: Producer | None = None) -> str:
+    """The key of an artefact: :func:`content_hash` of ``kind``, ``params``, the code hash of
+    its producer's fegear sources and the versions of its third-party dependencies.
+
+    Parameters
+    ----------
+    kind
+        Kind of artefact (its folder).
+    params
+        The content it is made from.
+    producer
+        Its producer; default the kind's in :data:`PRODUCERS`.
+
+    Raises
+    ------
+    ValueError
+        ``kind`` has no producer.
+    TypeError
+        ``params`` holds an object :func:`canonical` does not know.
+    """
+    p = _producer(kind, producer)
+    return content_hash(
+        {
+            "kind": kind,
+            "params": params,
+            "code": code_hash(*p.code),
+            "deps": dependency_versions(*p.deps),
+        }
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# What a run read and built
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CacheUse:
+    """The cache lookups of a piece of work (:func:`record_cache_use`).
+
+    Attributes
+    ----------
+    root
+        The cache root they went to.
+    hits
+        ``{kind: artefacts read from the cache}``.
+    built
+        ``{kind: artefacts built and written to the cache}``.
+    """
+
+    root: Path
+    hits: Mapping[str, int]
+    built: Mapping[str, int]
+
+    @property
+    def warm(self) -> bool:
+        """Everything came from the cache (at least one hit, nothing built)."""
+        return bool(self.hits) and not self.built
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready (``summary.json``: ``cache``)."""
+        return {"folder": str(self.root), "hits": dict(self.hits), "built": dict(self.built)}
+
+
+_RECORDERS: list[tuple[Counter, Counter]] = []
+
+
+@contextlib.contextmanager
+def record_cache_use() -> Iterator[Callable[[], CacheUse]]:
+    """Count the cache lookups made in this process inside the ``with`` block.
+
+    Yields a function returning the :class:`CacheUse` so far (call it after the block for the
+    whole of it). Lookups in worker processes are not seen (the artefacts of a run are looked up
+    in the main process: meshes, operators, TCA; the workers solve positions).
+    """
+    hits: Counter = Counter()
+    built: Counter = Counter()
+    entry = (hits, built)
+    _RECORDERS.append(entry)
+    root = cache_root()
+    try:
+        yield lambda: CacheUse(root, dict(sorted(hits.items())), dict(sorted(built.items())))
+    finally:
+        _RECORDERS.remove(entry)
+
+
+def _count(kind: str, hit: bool) -> None:
+    for hits, built in _RECORDERS:
+        (hits if hit else built)[kind] += 1
+
+
+def cached_file(
+    kind: str,
+    params: Mapping[str, object],
+    suffix: str,
+    build: Callable[[Path], None],
+    producer: Producer | None = None,
+) -> tuple[Path, bool]:
+    """Return the cached artefact for ``params``, building it with ``build(tmp_path)`` if absent.
+
+    Parameters
+    ----------
+    kind
+        Sub-folder, e.g. ``"mesh"`` or ``"compliance"``.
+    params
+        The content the artefact is made from (:func:`artefact_key`).
+    suffix
+        File suffix including the dot, e.g. ``".msh"``.
+    build
+        Writes the artefact to the path it is given (a temporary file in the cache folder,
+        renamed into place once ``build`` returns).
+    producer
+        The kind's producer; default its entry in :data:`PRODUCERS`.
+
+    Returns
+    -------
+    (path, hit)
+        The artefact path and whether it came from the cache.
+    """
+    key = artefact_key(kind, params, producer)
+    path = cache_dir(kind) / f"{key}{suffix}"
+    if path.exists():
+        log.info("cache hit %s/%s", kind, path.name)
+        _count(kind, True)
+        return path, True
+    atomic_write(path, build)
+    log.info("cache write %s/%s", kind, path.name)
+    _count(kind, False)
+    return path, False
+
+
+#: Suffix of a record's JSON document.
+RECORD_SUFFIX = ".json"
+_RECORD_FORMAT = "fegear.cache_record/1"
+_SUFFIX = re.compile(r"^(\.[A-Za-z0-9_]+)+$")
+
+
+class Entry:
+    """The files of one record (:func:`cached_record`): ``<key><suffix>`` in the kind's folder.
+
+    Attributes
+    ----------
+    folder
+        The kind's folder.
+    key
+        The artefact key.
+    """
+
+    def __init__(self, folder: Path, key: str, files: tuple[str, ...] = ()) -> None:
+        self.folder = folder
+        self.key = key
+        self._files = list(files)
+
+    def path(self, suffix: str) -> Path:
+        """The data file ``<key><suffix>`` (``suffix`` e.g. ``".npz"``, ``".msh"``)."""
+        if not _SUFFIX.match(suffix) or suffix == RECORD_SUFFIX:
+            raise ValueError(f"data file suffix {suffix!r}: '.name' other than {RECORD_SUFFIX!r}")
+        return self.folder / f"{self.key}{suffix}"
+
+    @property
+    def record_path(self) -> Path:
+        """The JSON document that makes the entry valid (written last)."""
+        return self.folder / f"{self.key}{RECORD_SUFFIX}"
+
+    @property
+    def files(self) -> tuple[str, ...]:
+        """Suffixes of the data files written (a new entry) or listed by the record (a hit)."""
+        return tuple(self._files)
+
+    def write(self, suffix: str, write: Callable[[Path], None]) -> Path:
+        """Write the data file ``<key><suffix>`` atomically with ``write(tmp_path)``."""
+        path = atomic_write(self.path(suffix), write)
+        if suffix not in self._files:
+            self._files.append(suffix)
+        return path
+
+
+def _read_record(folder: Path, key: str) -> tuple[dict, list[str]] | None:
+    """``(record, data file suffixes)`` of a complete entry, else None (no JSON document, or a
+    data file it lists is gone)."""
+    try:
+        doc = json.loads((folder / f"{key}{RECORD_SUFFIX}").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict) or doc.get("format") != _RECORD_FORMAT:
+        return None
+    files, record = doc.get("files"), doc.get("record")
+    if not isinstance(record, dict) or not isinstance(files, list):
+        return None
+    ok = all(
+        isinstance(f, str) and _SUFFIX.match(f) and (folder / f"{key}{f}").is_file() for f in files
+    )
+    return (record, files) if ok else None
+
+
+def cached_record(
+    kind: str,
+    params: Mapping[str, object],
+    build: Callable[[Entry], Mapping[str, object]],
+    producer: Producer | None = None,
+) -> tuple[Entry, dict, bool]:
+    """Return the cached record for ``params``, building it with ``build(entry)`` if absent.
+
+    A record is data files (written by ``build`` through :meth:`Entry.write`, each atomically)
+    and a JSON document ``<key>.json`` holding what ``build`` returns and the list of the data
+    files, written last: an entry is trusted only when that document exists and every file it
+    lists is there, so an entry cut short (by an error or a kill) is a miss and is built again.
+
+    Parameters
+    ----------
+    kind
+        Sub-folder, e.g. ``"tca"``.
+    params
+        The content the artefact is made from (:func:`artefact_key`).
+    build
+        Writes the data files of the entry and returns its record: plain JSON data (floats are
+        written by their ``repr``, so they read back bit for bit; NaN and infinities allowed).
+    producer
+        The kind's producer; default its entry in :data:`PRODUCERS`.
+
+    Returns
+    -------
+    (entry, record, hit)
+        The entry (:meth:`Entry.path` of its data files), the record, and whether it came from
+        the cache.
+    """
+    folder, key = cache_dir(kind), artefact_key(kind, params, producer)
+    found = _read_record(folder, key)
+    if found is not None:
+        entry = Entry(folder, key, tuple(found[1]))
+        log.info("cache hit %s/%s", kind, entry.record_path.name)
+        _count(kind, True)
+        return entry, found[0], True
+    entry = Entry(folder, key)
+    record = dict(build(entry))  # the data files, each written atomically
+    doc = {"format": _RECORD_FORMAT, "files": list(entry.files), "record": record}
+    text = json.dumps(doc, separators=(",", ":"))
+    atomic_write(entry.record_path, lambda p: p.write_text(text, encoding="utf-8"))
+    log.info("cache write %s/%s", kind, entry.record_path.name)
+    _count(kind, False)
+    return entry, json.loads(text)["record"], False  # as a hit reads it (tuples become lists)
+
+
+# --------------------------------------------------------------------------------------------
+# fegear cache info / clear
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class KindInfo:
+    """One kind of artefact in the cache.
+
+    Attributes
+    ----------
+    kind
+        Folder name (``"mesh"``, ``"compliance"``, ``"tca"``, …).
+    files
+        Number of artefacts.
+    bytes
+        Their total size (bytes).
+    """
+
+    kind: str
+    files: int
+    bytes: int
+
+
+@dataclass(frozen=True)
+class CacheInfo:
+    """Where the cache is and what it holds (:func:`cache_info`).
+
+    Attributes
+    ----------
+    root
+        The cache root.
+    source
+        ``"FEGEAR_CACHE"`` (set in the environment) or ``"platform"`` (the per-user default).
+    exists
+        The root exists.
+    is_cache
+        It is a fegear cache folder (:func:`is_cache_folder`).
+    kinds
+        One :class:`KindInfo` per kind folder, by name.
+    """
+
+    root: Path
+    source: str
+    exists: bool
+    is_cache: bool
+    kinds: tuple[KindInfo, ...]
+
+    @property
+    def files(self) -> int:
+        """Artefacts in all kinds."""
+        return sum(k.files for k in self.kinds)
+
+    @property
+    def bytes(self) -> int:
+        """Their total size (bytes)."""
+        return sum(k.bytes for k in self.kinds)
+
+
+def _artefacts(folder: Path) -> list[Path]:
+    return [p for p in folder.iterdir() if p.is_file() and _ARTEFACT.match(p.name)]
+
+
+def _kind_folders(root: Path) -> list[Path]:
+    return sorted(p for p in root.iterdir() if p.is_dir() and _KIND.match(p.name))
+
+
+def is_cache_folder(root: Path) -> bool:
+    """Whether ``root`` is a fegear cache: it holds the fegear ``CACHEDIR.TAG``, or (a cache of an
+    older fegear, made before the tag) every entry is a kind folder holding only content-hash
+    artefacts and at least one such folder exists."""
+    root = Path(root)
+    if not root.is_dir():
+        return False
+    tag = root / CACHE_TAG
+    if tag.is_file():
+        try:
+            text = tag.read_text(encoding="utf-8", errors="replace")
+        except OSError:
+            return False
+        return text.startswith(_SIGNATURE) and "fegear" in text
+    entries = list(root.iterdir())
+    if not entries:
+        return False
+    for p in entries:
+        if not (p.is_dir() and _KIND.match(p.name)):
+            return False
+        if any(not (q.is_file() and _ARTEFACT.match(q.name)) for q in p.iterdir()):
+            return False
+    return True
+
+
+def cache_info() -> CacheInfo:
+    """The cache root, where it comes from, and the files and bytes of each kind."""
+    root = cache_root()
+    source = "FEGEAR_CACHE" if os.environ.get("FEGEAR_CACHE", "").strip() else "platform"
+    if not root.is_dir():
+        return CacheInfo(root, source, False, False, ())
+    kinds = []
+    for folder in _kind_folders(root):
+        files = _artefacts(folder)
+        kinds.append(KindInfo(folder.name, len(files), sum(f.stat().st_size for f in files)))
+    return CacheInfo(root, source, True, is_cache_folder(root), tuple(kinds))
+
+
+def clear_cache(kind: str | None = None) -> CacheInfo:
+    """Delete the cached artefacts (of one ``kind``, or all); returns what was deleted.
+
+    Only content-hash artefacts inside kind folders are deleted (and a kind folder left empty);
+    anything else in the root stays.
+
+    Raises
+    ------
+    InputError
+        The root is not a fegear cache folder (:func:`is_cache_folder`; nothing is deleted), or
+        ``kind`` is not a kind folder of the cache.
+    """
+    info = cache_info()
+    if not info.exists:
+        return CacheInfo(info.root, info.source, False, False, ())
+    if not info.is_cache:
+        raise InputError(
+            "cache folder",
+            str(info.root),
+            f"a fegear cache folder (with fegear's {CACHE_TAG}); nothing was deleted",
+            "check FEGEAR_CACHE" if info.source == "FEGEAR_CACHE" else "",
+        )
+    names = [k.kind for k in info.kinds]
+    if kind is not None and kind not in names:
+        raise InputError("--kind", kind, f"one of the kinds in the cache {names}")
+    gone = []
+    for k in info.kinds:
+        if kind is not None and k.kind != kind:
+            continue
+        folder = info.root / k.kind
+        n = size = 0
+        for f in _artefacts(folder):
+            size += f.stat().st_size
+            f.unlink()
+            n += 1
+        if not any(folder.iterdir()):
+            shutil.rmtree(folder, ignore_errors=True)
+        gone.append(KindInfo(k.kind, n, size))
+        log.info("cache clear %s: %d files, %d bytes", k.kind, n, size)
+    return CacheInfo(info.root, info.source, True, True, tuple(gone))
