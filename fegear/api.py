@@ -35,8 +35,8 @@ import numpy as np
 from fegear.case import HertzCase
 from fegear.case import load_case as _load_case
 from fegear.errors import InputError
-from fegear.io.flank_view import PatternCentre
 from fegear.io.gear_case import ANALYSIS, FIDELITIES, N_LEVELS, GearCase
+from fegear.output.flank_view import PatternCentre
 
 __all__ = [
     "Checks",
@@ -422,7 +422,7 @@ class GearResult:
         Per position (:class:`Position`), each with its pairs (:class:`PairLoad`).
     pattern
         ``{"pinion": PatternCentre, "gear": PatternCentre}``: where the bearing pattern is on
-        each member's flank (:class:`fegear.io.flank_view.PatternCentre`, flank coordinates in
+        each member's flank (:class:`fegear.output.flank_view.PatternCentre`, flank coordinates in
         mm: ``face_mm`` along the face, ``profile_mm`` up the profile).
     warnings
         Warnings that change the meaning of a headline (and the solver's notes).
@@ -430,11 +430,11 @@ class GearResult:
         Wall time per stage (s).
     cache
         What the run read from the artefact cache and what it built
-        (:class:`fegear.mesh.cache.CacheUse`).
+        (:class:`fegear.store.cache.CacheUse`).
     summary
         The ``summary.json`` document (without its ``files`` list, which :meth:`write` fills).
     run
-        The full run (:class:`fegear.io.gear_run.GearRun`: contact cells, pressure fields,
+        The full run (:class:`fegear.pipeline.run.GearRun`: contact cells, pressure fields,
         displacement fields) for what the typed fields do not hold.
     """
 
@@ -479,8 +479,8 @@ class GearResult:
         InputError
             ``folder`` cannot be written (a file, or no permission).
         """
-        from fegear.io.files import check_writable_folder
-        from fegear.io.gear_output import write_gear_outputs
+        from fegear.output.gear_output import write_gear_outputs
+        from fegear.store.files import check_writable_folder
 
         out = check_writable_folder(folder, "folder")
         return tuple(write_gear_outputs(out, self.run, self._views))
@@ -520,11 +520,11 @@ class GearResult:
             A bad ``member``, or a fidelity without contact cells (``tca``, ``hertz``: use
             :func:`plot_patterns` for the contact path).
         """
-        from fegear.io.flank_view import plot_flank_pattern
+        from fegear.output.flank_view import plot_flank_pattern
 
         if member not in ("pinion", "gear"):
             raise InputError("member", member, "'pinion' or 'gear'")
-        if not self._views.patches or self.fidelity == "hertz":
+        if not self._views.patches or (self.run.kind is not None and not self.run.kind.cells):
             raise InputError(
                 "fidelity", self.fidelity, "'hybrid' or 'fe' (a fidelity with contact cells)"
             )
@@ -538,7 +538,7 @@ class GearResult:
 
 
 def _gear_result(run, views) -> GearResult:
-    from fegear.io.gear_output import gear_summary
+    from fegear.output.gear_output import gear_summary
 
     doc = gear_summary(run, None, views)
     doc.pop("files", None)
@@ -610,8 +610,8 @@ class HertzResult:
         """Write the files of ``fegear run`` for the scene into ``folder`` (``summary.json``,
         ``block.vtu``, ``roller.vtu``, ``contact_cells.vtu``, ``pressure_map.png``,
         ``convergence.png`` with a study). Returns the paths."""
-        from fegear.io.files import check_writable_folder
-        from fegear.io.hertz_output import write_hertz_outputs
+        from fegear.output.hertz_output import write_hertz_outputs
+        from fegear.store.files import check_writable_folder
 
         out = check_writable_folder(folder, "folder")
         return tuple(
@@ -755,9 +755,9 @@ def run(
         raise InputError("case", type(case).__name__, "a case from fegear.load_case")
     from dataclasses import replace
 
-    from fegear.io.gear_case import build_pair
-    from fegear.io.gear_output import flank_views
-    from fegear.io.gear_run import run_gear_case
+    from fegear.output.gear_output import flank_views
+    from fegear.pipeline.pair import build_pair
+    from fegear.pipeline.run import run_gear_case
 
     if study is not None:
         raise InputError("study", study, "absent for a gear case (a Hertz-scene option)")
@@ -819,7 +819,7 @@ def table(
     str
         The table (Markdown): ``TE p-p`` unloaded / loaded (arcsec), the unloaded contact ratio
         of one pair's path and the loaded contact ratio, p_max away from the edges (MPa), the
-        pattern centre ``face`` and ``profile`` (mm, :class:`~fegear.io.flank_view.FlankFrame`)
+        pattern centre ``face`` and ``profile`` (mm, :class:`~fegear.output.flank_view.FlankFrame`)
         and their shifts ``Δface``, ``Δprofile`` against the reference ("—": not reported).
     """
     from fegear.io.gear_case import error_fields
@@ -866,7 +866,7 @@ def table(
 def _savefig(fig, path: str | Path) -> Path:
     import matplotlib.pyplot as plt
 
-    from fegear.io.files import atomic_write
+    from fegear.store.files import atomic_write
 
     fig.tight_layout()
     out = atomic_write(Path(path), lambda q: fig.savefig(q, format="png", dpi=110))

@@ -14,7 +14,7 @@ cold on 2 cores, the sector meshes and compliance operators are then cached).
 
 ``fegear sweep CASE... [--grid KEY=START:STOP:N]`` runs several cases or a grid
 (:mod:`fegear.sweep`); ``fegear cache info | clear [--kind K]`` shows or empties the
-mesh/operator cache (:mod:`fegear.mesh.cache`: the per-user cache folder, or ``$FEGEAR_CACHE``);
+mesh/operator cache (:mod:`fegear.store.cache`: the per-user cache folder, or ``$FEGEAR_CACHE``);
 ``fegear plot FOLDER [--member gear|pinion]`` draws the bearing pattern over the cycle on a
 member's flank from a run's flank views.
 
@@ -174,8 +174,10 @@ def _run(args: argparse.Namespace) -> int:
 
 def _run_gear(args: argparse.Namespace, case) -> int:
     from fegear.api import run
-    from fegear.io.files import check_writable_folder
-    from fegear.io.gear_run import report
+    from fegear.io.gear_case import UNLOADED
+    from fegear.ltca.fidelity import FIDELITIES
+    from fegear.pipeline.run import report
+    from fegear.store.files import check_writable_folder
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
@@ -192,29 +194,22 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     lvl = case.level if args.level is None else args.level
     t_start = time.perf_counter()
     checks = "geometry, assembly and engagement checks (tip clearance, TCA of the positions)"
-    if fid in ("fe", "hybrid"):
-        layer = " and their layer below the flanks" if fid == "hybrid" else ""
-        labels = {
-            "geometry": f"[1/5] {checks}",
-            "models": f"[2/5] sector meshes and compliance operators{layer} (cached after the "
-            "first run)",
-            "positions": "[3/5] mesh positions (TCA + contact)",
-            "displacements": "[4/5] displacement fields (one sparse solve per member)",
-            "writing": "[5/5] writing outputs",
-        }
-    elif fid == "hertz":
-        labels = {
-            "geometry": f"[1/4] {checks}",
-            "models": "[2/4] sector meshes and compliance operators (cached after the first run)",
-            "positions": "[3/4] mesh positions (TCA + Hertz laws)",
-            "writing": "[4/4] writing outputs",
-        }
+    kind = FIDELITIES.get(fid)  # None: the unloaded TCA (or a bad name, refused by the run)
+    if kind is not None:
+        stages = [
+            ("geometry", checks),
+            ("models", f"{kind.models_text} (cached after the first run)"),
+            ("positions", f"mesh positions ({kind.positions_text})"),
+        ]
+        if kind.cells:
+            stages.append(("displacements", "displacement fields (one sparse solve per member)"))
     else:
-        labels = {
-            "geometry": "[1/3] geometry, assembly and tip clearance",
-            "tca": "[2/3] unloaded TCA over the cycle and engagement checks",
-            "writing": "[3/3] writing outputs",
-        }
+        stages = [
+            ("geometry", "geometry, assembly and tip clearance"),
+            ("tca", "unloaded TCA over the cycle and engagement checks"),
+        ]
+    stages.append(("writing", "writing outputs"))
+    labels = {s: f"[{i}/{len(stages)}] {text}" for i, (s, text) in enumerate(stages, 1)}
     stage_t = {"t": t_start, "started": False}
 
     def progress(stage: str, i: int | None, n: int | None) -> None:
@@ -223,7 +218,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             say(
                 f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
                 f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
-                + (f", level {lvl}" if fid != "tca" else "")
+                + (f", level {lvl}" if fid != UNLOADED else "")
                 + f", {case.n_positions} positions, out {out}/"
             )
         now = time.perf_counter()
@@ -248,7 +243,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     paths = result.write(out)
     rep = report(result.run)
     c = result.cycle
-    if result.fidelity != "tca":
+    if result.fidelity != UNLOADED:
         used = f" over {c.te_pp_loaded_positions_used} of {c.n_positions} positions"
         say(
             f"    TE p-p unloaded {_value(c.te_pp_unloaded_arcsec, '.2f', 'arcsec')}, loaded "
@@ -288,7 +283,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         say(f"    {n_other} positions with solver notes (summary.json: positions[i].warnings)")
     kinds = (
         "summary.json, cycle.pvd, vtk/, *.png"
-        if result.fidelity != "tca"
+        if result.fidelity != UNLOADED
         else "summary.json, *.png"
     )
     say(f"wrote {len(paths)} files to {out}/ ({kinds}) in {time.perf_counter() - t_start:.1f} s")
@@ -304,7 +299,7 @@ def _value(x: float | None, fmt: str, unit: str) -> str:
 
 def _run_hertz(args: argparse.Namespace, case) -> int:
     from fegear.api import run
-    from fegear.io.files import check_writable_folder
+    from fegear.store.files import check_writable_folder
 
     study = None
     if args.study:
@@ -358,7 +353,7 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
 
 
 def _cache(args: argparse.Namespace) -> int:
-    from fegear.mesh.cache import cache_info, clear_cache
+    from fegear.store.cache import cache_info, clear_cache
 
     if args.cache_command == "clear":
         gone = clear_cache(args.kind)
@@ -402,7 +397,7 @@ def _size(n: int) -> str:
 def _plot(args: argparse.Namespace) -> int:
     import json
 
-    from fegear.io.flank_view import plot_flank_pattern, read_flank_vtp
+    from fegear.output.flank_view import plot_flank_pattern, read_flank_vtp
 
     folder = Path(args.folder)
     files = sorted((folder / "vtk").glob(f"flank_{args.member}_*.vtp"))
@@ -434,7 +429,7 @@ def _plot(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from fegear.io.files import check_writable_folder
+    from fegear.store.files import check_writable_folder
     from fegear.sweep import build_items, require_dask, run_sweep
 
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))

@@ -169,8 +169,8 @@ def test_spiral_bevel_vh_script_on_dE(tmp_path, capsys):
 def test_spiral_bevel_synthesis_is_cached_on_disk():
     """The machine-setting synthesis behind every spiral bevel case (10-20 s) is an artefact of
     the cache: a second process reads it back (here: the second lookup), the same pair."""
-    from fegear.io.gear_case import _bevel_pair
-    from fegear.mesh.cache import record_cache_use
+    from fegear.pipeline.pair import _bevel_pair
+    from fegear.store.cache import record_cache_use
 
     p = fegear.load_case(REPO / "cases" / "spiral_bevel_nominal.toml").pair  # as build_pair
     blank = {"n1": p["n_pinion"], "n2": p["n_gear"], "module_mm": p["module_mm"],

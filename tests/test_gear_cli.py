@@ -190,7 +190,7 @@ def test_design_errors_name_the_case_key():
     """A geometry refusal (undercut, pointed tooth, …) names the case-file key, not the
     geometry's field; a pair given only in memory goes through the same schema."""
     from fegear.errors import InputError
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
 
     data = tomllib.loads(_edit(FZG_TEXT, "profile_shift = [0.1817, 0.1715]",
                                "profile_shift = [0.1817, 1.9]"))  # fmt: skip

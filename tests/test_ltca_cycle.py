@@ -127,7 +127,7 @@ def seed_face_gear():
     from pathlib import Path
 
     from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
 
     case = load_case(Path(__file__).parents[1] / "cases" / "face_gear_nominal.toml")
     pair = build_pair(case)

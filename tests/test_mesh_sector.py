@@ -270,9 +270,9 @@ def test_the_dgamma_face_gear_sector_meshes_with_hxt_first_time():
     AVX-512 host of session 10 made none: 0 fixed), so the test asks for what must hold on
     every host: one attempt, HXT, and a valid mesh."""
     from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
     from fegear.ltca import LTCAOptions
     from fegear.ltca.analysis import cycle_zone
+    from fegear.pipeline.pair import build_pair
 
     repo = Path(__file__).resolve().parents[1]
     case = load_case(repo / "cases" / "face_gear_dgamma_minus.toml")

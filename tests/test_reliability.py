@@ -53,8 +53,8 @@ def test_main_job_runs_the_seed_face_gear_at_hybrid(tmp_path, monkeypatch):
     """``fegear run`` with no case: the seed face gear at hybrid level 0 (the run itself, ~1 min
     cold, is ``test_gear_cli.test_no_argument_main_job_writes_all_outputs``, slow): here the
     case and fidelity that reach the analysis, and the summary that records them."""
-    import fegear.io.gear_run as gear_run
-    from fegear.io.gear_output import gear_summary
+    import fegear.pipeline.run as gear_run
+    from fegear.output.gear_output import gear_summary
 
     seen = {}
 
@@ -122,9 +122,9 @@ def test_spiral_bevel_p_max_is_the_hertz_value_of_its_most_loaded_interior_posit
     curvatures of the TCA at that pair's contact point), the edge value reported separately."""
     from fegear.case import load_case
     from fegear.hertz import effective_modulus, hertz_point
-    from fegear.io.gear_case import build_pair
     from fegear.ltca import LTCAOptions
     from fegear.ltca.cycle import cycle_tca
+    from fegear.pipeline.pair import build_pair
 
     out = tmp_path / "out"
     assert main(["run", str(BEVEL), "--out", str(out), "-q"]) == 0
@@ -212,7 +212,7 @@ def test_tip_clearance_of_the_error_free_pairs():
     distance less tip radius less root radius), and both tips of the face gear clear by the
     dedendum less the addendum."""
     from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
     from fegear.tca.engagement import tip_root_clearance
 
     pair = build_pair(load_case(FZG))
@@ -284,7 +284,7 @@ def test_handover_of_a_conjugate_pair_is_its_contact_ratio():
     from dataclasses import replace
 
     from fegear.case import load_case
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
     from fegear.tca import TCA, TCAOptions, reference_phase
     from fegear.tca.engagement import handover
 

@@ -1,4 +1,4 @@
-"""Root stress from the stress sectors (fegear.fem.stress, fegear.io.gear_run.displacements) and
+"""Root stress from the stress sectors (fegear.fem.stress, fegear.pipeline.run.displacements) and
 the ISO 6336-3 method B reference (fegear.validation.iso6336_root)."""
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def test_iso6336_3_critical_section_is_the_generated_fillets():
     """ISO 6336-3 §6.2-6.3 closed forms (sFn, ρF, hFe of the 30° tangent) against the same
     quantities measured on fegear's generated FZG teeth (the trochoid of the rack tip circle,
     the involute): the formulas are exact geometry for a rack-generated tooth."""
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
     from fegear.validation.iso6336_root import _fzg_case, critical_section_check, fzg_reference
 
     case = _fzg_case()
@@ -81,9 +81,9 @@ def test_iso6336_3_critical_section_is_the_generated_fillets():
 def fzg_stress():
     """FZG hybrid level 0 at two positions (one in single contact), loaded stress sectors with
     coarse fillets (0.5 m: a small solve; the equilibrium does not depend on the size)."""
-    from fegear.io.gear_case import build_pair
-    from fegear.io.gear_run import GearRun, displacements
     from fegear.ltca import LTCAOptions, build_models, run_ltca
+    from fegear.pipeline.pair import build_pair
+    from fegear.pipeline.run import GearRun, displacements
     from fegear.tca.results import ARCSEC
     from fegear.validation.iso6336_root import _fzg_case
 
@@ -126,7 +126,7 @@ def test_loaded_tooth_has_tension_on_the_loaded_side(fzg_stress):
 
 
 def test_summary_has_the_root_stress_keys(fzg_stress):
-    from fegear.io.gear_output import gear_summary
+    from fegear.output.gear_output import gear_summary
 
     doc = json.loads(json.dumps(gear_summary(fzg_stress)))  # JSON-clean
     c = doc["cycle"]
@@ -149,7 +149,7 @@ def test_summary_has_the_root_stress_keys(fzg_stress):
 def test_vtk_sectors_carry_the_stress_fields(fzg_stress, tmp_path):
     import meshio
 
-    from fegear.io.gear_output import _member_mesh, _write_vtu
+    from fegear.output.gear_output import _member_mesh, _write_vtu
 
     mf = fzg_stress.members[0]
     path = _write_vtu(tmp_path / "p.vtu", _member_mesh(mf, 0, fzg_stress.cycle.positions[0]))

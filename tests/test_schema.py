@@ -116,12 +116,14 @@ def test_the_bevel_edge_radius_reaches_the_synthesis(monkeypatch):
         seen.update(blank_kw)
         raise RuntimeError("recorded")
 
-    monkeypatch.setattr(gc, "_bevel_pair", record)
+    from fegear.pipeline import pair as pp
+
+    monkeypatch.setattr(pp, "_bevel_pair", record)
     doc = {**SEED_BEVEL, "pair": {**SEED_BEVEL["pair"], "edge_radius_mm": 0.6}}
     with pytest.raises(RuntimeError, match="recorded"):
-        gc.build_pair(parse_case(doc))
+        pp.build_pair(parse_case(doc))
     assert seen["edge_radius_mm"] == 0.6
     seen.clear()
     with pytest.raises(RuntimeError, match="recorded"):
-        gc.build_pair(parse_case(SEED_BEVEL))
+        pp.build_pair(parse_case(SEED_BEVEL))
     assert "edge_radius_mm" not in seen  # absent: the synthesis chooses it

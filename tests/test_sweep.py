@@ -214,8 +214,8 @@ def test_missing_reference_item_is_an_error(fzg3, tmp_path, capsys):
     assert main([*argv, "-q"]) == 0
     ref = "fzg_spur__f_sigma_beta_mm=0"
     assert json.loads((out / "sweep.json").read_text())["comparison"]["nominal"] == ref
-    from fegear.io.sweep_output import comparison, key_results, reference_item
     from fegear.sweep import build_items, verified_summary
+    from fegear.sweep.output import comparison, key_results, reference_item
 
     items = build_items([fzg3], ["errors.f_sigma_beta_mm=0,0.005"], fidelity="tca")
     other = items[1].name
@@ -363,7 +363,7 @@ def test_leftovers_of_a_killed_run_are_cleaned(tmp_path):
     """A run killed between an atomic write and its rename leaves ``.sweep.<random>.json``
     (seen once in CI: the kill of the resume test landed there); the next run removes it with the
     unfinished item folders, and keeps the lock file."""
-    from fegear.sweep import _clean_tmp
+    from fegear.sweep.run import _clean_tmp
 
     (tmp_path / ".item.ab12.tmp").mkdir()
     (tmp_path / ".item.ab12.tmp" / "summary.json").write_text("{")

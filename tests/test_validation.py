@@ -69,7 +69,7 @@ def test_the_references_agree_with_fegear_geometry():
     """The closed-form pair (ISO 21771) is the pair fegear generates: same base radii, same
     centre distance (the assembly's, from the generated profiles), to round-off."""
     from fegear.api import load_case
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
 
     pair = build_pair(load_case(REPO / "cases" / "fzg_spur.toml"))
     h, _ = V.fzg_reference()

@@ -1,6 +1,7 @@
-"""Writers of results: JSON summary, VTK for ParaView, PNG pictures.
+"""Case files: the declarative schema (:mod:`fegear.io.schema`), gear-pair cases
+(:mod:`fegear.io.gear_case`), the built-in seed case (:mod:`fegear.io.seed`) and the version
+records written into results (:mod:`fegear.io.records`).
 
-Modules: :mod:`fegear.io.files` (atomic writes, used by the caches too),
-:mod:`fegear.io.hertz_output`, :mod:`fegear.io.gear_output`, :mod:`fegear.io.sweep_output`.
-The package root imports nothing heavy, so low-level modules may use :mod:`fegear.io.files`.
+``io`` reads and validates; it builds nothing and imports nothing from the model layers
+(``tca``, ``ltca``, ``mesh``, ``scenes``) or from the pipeline.
 """

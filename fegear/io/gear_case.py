@@ -1,4 +1,4 @@
-"""Gear-pair case files (TOML): schema, validation and the pair they describe.
+"""Gear-pair case files (TOML): schema and validation, read into a :class:`GearCase`.
 
 Units are in the key names (DESIGN §3). Unknown sections and keys are refused with the closest
 known key suggested (which catches a wrong unit suffix: ``module_in`` → ``module_mm``), missing
@@ -44,17 +44,17 @@ from fegear.io.schema import (
     check_table,
     reference_markdown,
 )
+from fegear.options import ContactOptions
 
 __all__ = [
     "GEAR_KINDS",
     "DEFAULT_FIDELITY",
     "FIDELITIES",
+    "UNLOADED",
     "N_LEVELS",
     "GearCase",
-    "GearPair",
+    "CONTACT",
     "parse_gear_case",
-    "build_pair",
-    "assemble",
     "error_fields",
     "reference",
     "sections",
@@ -62,7 +62,10 @@ __all__ = [
 
 GEAR_KINDS = ("face_gear", "spur", "spiral_bevel")
 #: Fidelities of the gear pairs (DESIGN §9).
-FIDELITIES = ("fe", "hertz", "hybrid", "tca")
+#: The unloaded analysis (rigid TCA only); the others are the loaded fidelities of
+#: :data:`fegear.ltca.fidelity.FIDELITIES` (tests/test_architecture.py keeps the two in step).
+UNLOADED = "tca"
+FIDELITIES = ("fe", "hertz", "hybrid", UNLOADED)
 #: The fidelity of a gear case that does not name one: the one that resolves the contact patch
 #: at the default (coarsest) level. ``fe`` level 0 does not: its cells are wider than the patch
 #: (FZG: p_max 126-160 MPa where ``hybrid``, ``hertz`` and line Hertz give about 1100 MPa; seed
@@ -408,6 +411,37 @@ MATERIAL = Section(
         ),
     ),
 )
+_C = ContactOptions
+CONTACT = Section(
+    "contact",
+    (
+        Key("g_max_mm", NUMBER, "separation below which contact cells are laid, mm (raised "
+            "automatically while a left-out cell could close)", default=_C.default("g_max_mm"),
+            range=_POS),
+        Key("cell_mm", NUMBER, "contact-cell size, mm (default: the fine element size)",
+            range=_POS, allowed="> 0, or absent (automatic)"),
+        Key("n_across", INTEGER, "hybrid: cells across each loaded patch (its minor axis)",
+            default=_C.default("n_across"), range=Range(1, None)),
+        Key("n_along", INTEGER, "hybrid: cells along each loaded patch (its major axis)",
+            default=_C.default("n_along"), range=Range(1, None)),
+        Key("max_cells", INTEGER, "hybrid: cells of one pair at most", default=_C.default(
+            "max_cells"), range=Range(1, None)),
+        Key("trim", NUMBER, "hybrid: cells predicted open beyond trim θ h_max are left out of "
+            "a warm solve (checked afterwards; 0 keeps every cell)", default=_C.default("trim"),
+            range=_NONNEG),
+        Key("depth_elements", NUMBER, "hybrid: matching-layer depth in fine elements",
+            default=_C.default("depth_elements"), range=_POS),
+        Key("depth_max_modules", NUMBER, "hybrid: matching-layer depth at most, in modules",
+            default=_C.default("depth_max_modules"), range=_POS),
+        Key("tca_grid", INT_PAIR, "cells of the TCA separation field the contact zone is "
+            "found on", default=list(_C.default("tca_grid")), range=Range(2, None),
+            labels=("u", "v")),
+        Key("chunk_positions", INTEGER, "positions solved in sequence by one worker, each "
+            "from its predecessor", default=_C.default("chunk_positions"), range=Range(1, None)),
+    ),
+    "Tuning of the loaded contact models; every default is a measured choice "
+    "(benchmarks/results/contact_options.md). Leave it out unless you study the method.",
+)  # fmt: skip
 
 
 def sections(kind: str) -> tuple[Section, ...]:
@@ -417,12 +451,12 @@ def sections(kind: str) -> tuple[Section, ...]:
         ERROR_KEYS["parallel" if kind == "spur" else "intersecting"],
         "Installation errors, all 0 by default (sign conventions: fegear.assembly).",
     )
-    return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL)
+    return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL, CONTACT)
 
 
 def reference() -> str:
     """The gear case-file reference (Markdown), from the declarations."""
-    common = (CASE, LOAD, ANALYSIS, MATERIAL)
+    common = (CASE, LOAD, ANALYSIS, MATERIAL, CONTACT)
     errors = tuple(
         Section("errors", keys, f"Installation errors, {what}; all 0 by default.")
         for keys, what in ((ERROR_KEYS["intersecting"], _INTERSECTING),
@@ -456,6 +490,8 @@ class GearCase:
         Installation errors.
     fidelity, level, n_positions, n_teeth, backend, root_stress
         Analysis settings (``[analysis]``).
+    contact
+        Tuning of the contact models (``[contact]``, :class:`~fegear.options.ContactOptions`).
     E_MPa, nu
         Material of both members.
     speed_rpm
@@ -477,6 +513,7 @@ class GearCase:
     n_teeth: int | None = None
     backend: str = "auto"
     root_stress: bool = False
+    contact: ContactOptions = field(default_factory=ContactOptions)
     E_MPa: float = 206000.0
     nu: float = 0.3
     speed_rpm: float | None = None
@@ -507,7 +544,7 @@ class GearCase:
         }
         if self.n_teeth is not None:
             analysis["n_teeth"] = self.n_teeth
-        return {
+        doc = {
             "case": case,
             "pair": copy.deepcopy(self.pair),
             "load": load,
@@ -515,6 +552,9 @@ class GearCase:
             "analysis": analysis,
             "material": {"E_MPa": self.E_MPa, "nu": self.nu},
         }
+        if self.contact.given():
+            doc["contact"] = self.contact.given()
+        return doc
 
     def replace(self, **changes: Any) -> GearCase:
         """A new, validated case with some fields changed (the case itself is frozen).
@@ -528,7 +568,9 @@ class GearCase:
             ``speed_rpm`` (rpm, recorded only), ``errors`` (an
             :class:`~fegear.assembly.InstallationErrors` or a mapping of the ``[errors]`` keys:
             it replaces all of them, the ones not given are 0), ``pair`` (the whole ``[pair]``
-            table: ``case.replace(pair={**case.pair, "module_mm": 5.0})``), a load, which
+            table: ``case.replace(pair={**case.pair, "module_mm": 5.0})``), ``contact`` (a
+            :class:`~fegear.options.ContactOptions` or a mapping of the ``[contact]`` keys: it
+            replaces all of them, the ones not given take their defaults), a load, which
             replaces the case's torque (``torque2_Nm``, N·m, or ``torque2_Nmm``, N·mm, on
             member 2; ``pinion_torque_Nm``, N·m, on member 1), and ``source``.
 
@@ -565,6 +607,12 @@ class GearCase:
                 if not isinstance(value, dict):
                     raise InputError("pair", value, "a mapping of the [pair] keys")
                 doc["pair"] = value
+            elif key == "contact":
+                if isinstance(value, ContactOptions):
+                    value = value.given()
+                if not isinstance(value, dict):
+                    raise InputError("contact", value, "ContactOptions or a mapping")
+                doc["contact"] = value
             elif key == "errors":
                 if isinstance(value, InstallationErrors):
                     value = {k: getattr(value, k) for k in _error_keys(self.kind)}
@@ -572,7 +620,9 @@ class GearCase:
                     raise InputError("errors", value, "InstallationErrors or a mapping")
                 doc["errors"] = value
             else:
-                known = sorted([*_REPLACE_KEYS, *_TORQUE_KEYS, "pair", "errors", "source"])
+                known = sorted(
+                    [*_REPLACE_KEYS, *_TORQUE_KEYS, "pair", "errors", "contact", "source"]
+                )
                 close = difflib.get_close_matches(key, known, n=1, cutoff=0.5)
                 hint = f"did you mean {close[0]!r}?" if close else ""
                 if key in ("kind", "load_key", "load_value"):
@@ -631,6 +681,9 @@ class GearCase:
                 "root_stress": self.root_stress,
             },
             "material": {"E_MPa": self.E_MPa, "nu": self.nu},
+            "contact": {
+                k: list(v) if isinstance(v, tuple) else v for k, v in self.contact.as_dict().items()
+            },
         }
 
 
@@ -713,7 +766,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     kind = data["case"].get("kind") if isinstance(data["case"], dict) else None
     if kind not in GEAR_KINDS:
         raise InputError("case.kind", kind, f"one of {GEAR_KINDS}")
-    case_s, pair_s, load_s, errors_s, analysis_s, material_s = sections(kind)
+    case_s, pair_s, load_s, errors_s, analysis_s, material_s, contact_s = sections(kind)
     check_document(data, sections(kind))
     for_kind = f" for kind {kind!r}"
     case = check_table(case_s, data["case"])
@@ -722,6 +775,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     errs = check_table(errors_s, data.get("errors", {}), for_kind)
     ana = check_table(analysis_s, data.get("analysis", {}))
     mat = check_table(material_s, data.get("material", {}))
+    tuning = check_table(contact_s, data.get("contact", {}))
 
     given = [k for k in _TORQUE_KEYS if k in load]
     if len(given) != 1:
@@ -750,6 +804,16 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         errors = InstallationErrors(**{k: float(v) for k, v in errs.items()})
     except InputError as exc:
         raise InputError(exc.field, exc.value, exc.allowed) from exc
+    values = {n: contact_s.value(tuning, n) for n in ContactOptions.names()}
+    values["tca_grid"] = tuple(int(n) for n in values["tca_grid"])
+    numbers = ("g_max_mm", "trim", "depth_elements", "depth_max_modules")
+    values.update({n: float(values[n]) for n in numbers})
+    if values["cell_mm"] is not None:
+        values["cell_mm"] = float(values["cell_mm"])
+    try:
+        contact = ContactOptions(**values)
+    except InputError as exc:
+        raise InputError(f"contact.{exc.field}", exc.value, exc.allowed) from exc
     return GearCase(
         name=case.get("name", Path(source).stem),
         kind=kind,
@@ -764,165 +828,13 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         n_teeth=None if n_teeth is None else int(n_teeth),
         backend=backend,
         root_stress=root_stress,
+        contact=contact,
         E_MPa=E,
         nu=nu,
         speed_rpm=float(load["speed_rpm"]) if "speed_rpm" in load else None,
         description=case_s.value(case, "description"),
         source=source,
     )
-
-
-# --------------------------------------------------------------------------------------------
-# The pair a case describes
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class GearPair:
-    """Generated members and their assembly (with the case's installation errors)."""
-
-    pinion: Any
-    gear: Any
-    assembly: Any
-    spiral_bevel: Any = None
-
-
-# design-field name (as the geometry reports it) -> case-file key
-_FACE_GEAR_FIELDS = {"n_shaper_teeth": "n_shaper"}
-_SPUR_FIELDS = {"n_teeth": "teeth", "face_width_mm": "face_width_mm"}
-_BEVEL_FIELDS = {
-    "n1": "n_pinion",
-    "n2": "n_gear",
-    "te_amplitude_arcsec": "te_amplitude_arcsec",
-}
-_BEVEL_CACHE: dict[tuple, Any] = {}
-
-
-def _renamed(
-    exc: InputError, member: int | None, table: dict[str, str], case: GearCase
-) -> InputError:
-    """The geometry's error with the field renamed to the case-file key (or, for a derived
-    quantity such as the tip radius, named with the member it belongs to)."""
-    f = exc.field.split(".")[-1]
-    key = table.get(f, f)
-    pair = case.pair
-    if key in PAIR_SECTIONS[case.kind].names:
-        fld = f"pair.{key}"
-        if member is not None and isinstance(pair.get(key), list):
-            fld += f"[{member}]"
-        return type(exc)(fld, exc.value, exc.allowed)
-    who = {0: "pinion", 1: "gear"}.get(member, case.kind)  # type: ignore[arg-type]
-    return type(exc)(f"pair ({who} {f}, derived from the [pair] data)", exc.value, exc.allowed)
-
-
-def _member_value(pair: dict, key: str, i: int) -> float:
-    """Member ``i``'s value of a number-or-pair ``[pair]`` key of a spur case (its declared
-    default when absent)."""
-    v = PAIR_SECTIONS["spur"].value(pair, key)
-    return float(v[i]) if isinstance(v, list) else float(v)
-
-
-def build_pair(case: GearCase) -> GearPair:
-    """Generate the members of a case and assemble them with its installation errors.
-
-    Raises
-    ------
-    InputError, DesignError
-        Design data that cannot make a valid tooth, naming the case-file key.
-    """
-    from fegear.assembly import face_gear_assembly, involute_assembly, spiral_bevel_assembly
-
-    p = case.pair
-    if case.kind == "face_gear":
-        from fegear.geometry import FaceGearDesign, FaceGearMember
-
-        kw = {k: v for k, v in p.items() if k != "n_shaper"}
-        if "n_shaper" in p:
-            kw["n_shaper_teeth"] = p["n_shaper"]
-        try:
-            fg = FaceGearMember(FaceGearDesign(**kw))
-            pinion = fg.pinion()
-        except InputError as exc:
-            raise _renamed(exc, None, _FACE_GEAR_FIELDS, case) from exc
-        return GearPair(pinion, fg, face_gear_assembly(fg, case.errors, pinion))
-    if case.kind == "spur":
-        from fegear.geometry import InvoluteDesign, InvoluteMember
-
-        members = []
-        for i, name in enumerate(("pinion", "gear")):
-            try:
-                d = InvoluteDesign(
-                    n_teeth=int(p["teeth"][i]),
-                    module_mm=float(p["module_mm"]),
-                    pressure_angle_deg=float(p["pressure_angle_deg"]),
-                    profile_shift=_member_value(p, "profile_shift", i),
-                    face_width_mm=_member_value(p, "face_width_mm", i),
-                    addendum_coeff=_member_value(p, "addendum_coeff", i),
-                    dedendum_coeff=_member_value(p, "dedendum_coeff", i),
-                    profile_crowning_mm=_member_value(p, "profile_crowning_mm", i),
-                    lead_crowning_mm=_member_value(p, "lead_crowning_mm", i),
-                    tip_relief_mm=_member_value(p, "tip_relief_mm", i),
-                )
-                members.append(InvoluteMember(d, name))
-            except InputError as exc:
-                raise _renamed(exc, i, _SPUR_FIELDS, case) from exc
-        return GearPair(members[0], members[1], involute_assembly(*members, case.errors))
-    # spiral bevel: the synthesis (~10-20 s) is cached per process and on disk for the same
-    # blank data (_bevel_pair)
-
-    blank_kw = {
-        "n1": int(p["n_pinion"]),
-        "n2": int(p["n_gear"]),
-        "module_mm": float(p["module_mm"]),
-        "spiral_angle_deg": float(p["spiral_angle_deg"]),
-        "pressure_angle_deg": float(p["pressure_angle_deg"]),
-        "face_width_mm": float(p["face_width_mm"]),
-    }
-    for k in ("shaft_angle_deg", "cutter_radius_mm", "edge_radius_mm"):
-        if k in p:
-            blank_kw[k] = float(p[k])
-    target_kw = {}
-    if "te_amplitude_arcsec" in p:
-        target_kw["te_amplitude_arcsec"] = float(p["te_amplitude_arcsec"])
-    key = (tuple(sorted(blank_kw.items())), tuple(sorted(target_kw.items())))
-    try:
-        if key not in _BEVEL_CACHE:
-            _BEVEL_CACHE[key] = _bevel_pair(blank_kw, target_kw)
-        sb = _BEVEL_CACHE[key]
-    except InputError as exc:
-        raise _renamed(exc, None, _BEVEL_FIELDS, case) from exc
-    side = PAIR_SECTIONS["spiral_bevel"].value(p, "side")
-    return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
-
-
-def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
-    """The synthesized spiral bevel pair of the blank data: read from the artefact cache when
-    the same blank and targets were synthesized before by the same geometry code (the synthesis
-    takes 10-20 s), else synthesized and cached. The entry is the pair's plain-data record
-    (:meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.record`, JSON: no pickle); the key
-    holds a hash of the source of the geometry and TCA packages
-    (:func:`fegear.tca.cached._source_hash`), so a change of the synthesis invalidates it."""
-    import json
-
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
-    from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
-    from fegear.mesh.cache import cached_file
-    from fegear.tca.cached import _source_hash
-
-    box: dict[str, Any] = {}
-
-    def build(path: Path) -> None:
-        # a design error raises here, before anything is written (nothing is cached)
-        box["pair"] = SpiralBevelPair.design(
-            SpiralBevelBlank(**blank_kw), SynthesisTargets(**target_kw)
-        )
-        path.write_text(json.dumps(box["pair"].record()), encoding="utf-8")
-
-    params = {"blank": blank_kw, "targets": target_kw, "source": _source_hash()}
-    path, hit = cached_file("bevel_pair", params, ".json", build)
-    if not hit:
-        return box["pair"]
-    return SpiralBevelPair.from_record(json.loads(path.read_text(encoding="utf-8")))
 
 
 def error_fields(case: GearCase) -> list[tuple[str, float]]:
@@ -933,14 +845,3 @@ def error_fields(case: GearCase) -> list[tuple[str, float]]:
         for k in _error_keys(case.kind)
         if getattr(case.errors, k) != 0.0
     ]
-
-
-def assemble(case: GearCase, pair: GearPair, errors: InstallationErrors):
-    """The assembly of ``pair`` with other installation ``errors`` (same members and flanks)."""
-    from fegear.assembly import face_gear_assembly, involute_assembly, spiral_bevel_assembly
-
-    if case.kind == "face_gear":
-        return face_gear_assembly(pair.gear, errors, pair.pinion)
-    if case.kind == "spur":
-        return involute_assembly(pair.pinion, pair.gear, errors)
-    return spiral_bevel_assembly(pair.spiral_bevel, case.pair.get("side", "drive"), errors)

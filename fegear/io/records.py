@@ -9,12 +9,15 @@ from fegear.contact import ContactSolution
 
 __all__ = ["solver_record", "versions"]
 
+#: Recorded in every summary; ``pyvista`` (extra ``view``) and ``mkl`` (extra ``pardiso``) are
+#: optional, recorded as ``"not installed"`` where absent.
 _PACKAGES = ("fegear", "numpy", "scipy", "scikit-fem", "gmsh", "meshio", "pyvista", "matplotlib",
-             "pypardiso")  # fmt: skip
+             "mkl")  # fmt: skip
 
 
 def versions() -> dict[str, str]:
-    """Python and package versions of this run (``"not installed"`` where absent)."""
+    """Python and package versions of this run (``"not installed"`` where absent: the optional
+    extras)."""
     out = {"python": platform.python_version()}
     for pkg in _PACKAGES:
         try:

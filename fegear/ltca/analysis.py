@@ -26,9 +26,7 @@ cells whose loaded gap, predicted from that solution's approach field ``g − d`
 problem restricted to cells that hold its active set has the same solution, so the trimmed
 solve is accepted only if the ring of left-out cells around the kept ones stays open under it
 (their loaded gap computed from the active cells' forces, :func:`_trim_holds`); otherwise the
-position is solved on all cells. Measured on the seed face gear (hybrid level 0, 25 positions,
-``trim = 0.3``): 57 % of the cells kept, no trimmed solve rejected, loaded TE equal to 1e-11″,
-warm positions 6.1–7.3 → 4.1–4.7 s in one process (alternating runs).
+position is solved on all cells (what it saves: ``benchmarks/results/contact_options.md``).
 
 The ``hybrid`` fidelity (DESIGN §7) changes step 3 inside each pair: see
 :mod:`fegear.ltca.hybrid`. :func:`fegear.ltca.cycle.run_ltca` runs the positions of a cycle.
@@ -45,13 +43,13 @@ from scipy.spatial import cKDTree
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
+from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.grid import PairCells, edge_names, missing_pairs, pair_cells, take_cells
-from fegear.ltca.hybrid import hybrid_compliance, hybrid_displacement, refined_sizes
+from fegear.ltca.hybrid import hybrid_displacement, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
     build_member_model,
     cell_load_operators,
-    member_compliance,
 )
 from fegear.ltca.results import (
     DEGENERATE_SHARE,
@@ -63,6 +61,7 @@ from fegear.ltca.results import (
 from fegear.ltca.warm import active_guess, footprint, likely_cells, ring_cells
 from fegear.ltca.zone import ContactZone, contact_zone, left_out_pairs
 from fegear.mesh.sector import FINE, sector_mesh
+from fegear.options import ContactOptions
 from fegear.patch import measure_patch
 from fegear.tca import TCA, TCAOptions
 from fegear.tca.cached import cached_tca
@@ -72,8 +71,6 @@ __all__ = ["LTCAOptions", "MemberModels", "build_models", "cycle_zone", "solve_p
 
 log = logging.getLogger(__name__)
 
-# fe: the cells are element-sized, the cap only bounds the dense compliance of a huge zone.
-_FE_MAX_CELLS = 1500
 #: ``hybrid`` cell trimming: a trimmed solve is accepted when the loaded gap of the ring of cells
 #: left out around the kept ones stays above this fraction of the rigid approach ``θ h_max``
 #: (measured with ``trim = 0.3``: the closest left-out cell stayed 1.4 µm = 0.16 θ h_max open on
@@ -97,67 +94,23 @@ class LTCAOptions:
         Teeth per sector; None: every tooth that can touch in the cycle plus one unloaded
         neighbour on each side (:func:`fegear.ltca.zone.contact_zone`; 5 on the seed face gear
         and the spiral bevel).
-    cell_mm
-        Contact cell size; None: the fine element size of the coarser member. Cells much
-        smaller than the P2 elements make the FE compliance ``PᵀK⁻¹P`` rank-deficient (more
-        cells than surface DOFs under them), so the ``fe`` fidelity cannot resolve patches
-        narrower than its elements: that is the ``hybrid`` fidelity's job.
-    g_max_mm
-        Initial separation cut-off (doubled automatically while too small).
-    tca_grid
-        Coarse separation grid of the TCA (nu, nv).
     E_MPa, nu
         Material of both members.
     backend
         Sparse direct backend.
     fidelity
-        ``"fe"``: the contact grid with the FE compliance (cells one element wide).
-        ``"hertz"``: per-pair Hertz laws and lumped FE compliance (:mod:`fegear.ltca.hertz_model`).
-        ``"hybrid"``: the FE read at a matching depth ``d`` below every cell plus
-        the closed-form half-space compression of the layer above it (Vijayakar 1991; the split
-        validated on the Hertz scene, :func:`fegear.scenes.hertz_scene.hybrid_compliance`),
-        inside each pair; plain ``PᵀK⁻¹P`` between pairs. The cells are refined below the
-        element size until ``n_across`` of them span each loaded patch across and ``n_along``
-        along it.
-    n_across
-        ``hybrid``: cells wanted across each loaded patch (its minor axis).
-    n_along
-        ``hybrid``: cells wanted along each loaded patch (its major axis; never coarser than
-        the element size). The loaded TE converges in the cell length along the patch:
-        measured at level 0 against grids of 0.14-0.35 mm cells along (the TE within 0.002″):
-        seed face gear, φ1 = 4.32° (one pair, 35 mm long patch), n_along 8 / 16 / 32: TE
-        −4.0996 / −4.1056 / −4.1064″; cycle TE rms error 0.0079 / 0.0064″ (8 / 16), TE
-        peak-to-peak −4.9 / −0.9 %; spiral bevel, positions 0 / 8 / 16: errors 0.12-0.14″ (8)
-        → 0.05-0.08″ (16) of 73-84″, interior p_peak +1.1-2.6 % → +0.9-1.2 %, shares within
-        0.001 either way. Cost (warm cycle, 2 workers): face gear 1.9 → 2.2 s, bevel
-        5.1 → 7.5 s.
-    max_cells
-        ``hybrid``: cells per pair at most (both sizes grow in proportion beyond): caps the
-        cost of the dense compliance (n²) where a pair's patch is tiny, i.e. at an edge
-        contact, whose pressure is singular and does not converge under refinement anyway
-        (measured on the spiral bevel: 3614 cells, 15 s for one solve, without the cap); the
-        ``fe`` cells are element-sized (cap 1500). Interior patches take
-        200-550 cells at ``n_across = 8``. Measured (hybrid level 0, 25 positions, cap 1500 ->
-        600): seed face gear loaded TE within 0.003", load shares within 0.0005, warm positions
-        8.8 -> 5.8 s; spiral bevel TE within 0.04", shares within 0.0006, 18.8 -> 11.8 s; only
-        the (singular) edge-contact p_max changes.
-    depth_elements, depth_max_modules
-        ``hybrid``: ``d = min(depth_elements h, depth_max_modules m)`` (``h`` the fine element
-        size, ``m`` the module). Measured on the FZG pair: positive definite from d = 1.1 h.
-    trim
-        ``hybrid``: a position (or a refined grid) that follows a solved one leaves out the
-        cells whose loaded gap, predicted from that solution's approach field, exceeds
-        ``trim θ h_max`` (:func:`fegear.ltca.warm.likely_cells`), and checks afterwards that
-        they stay open (else it solves on all cells); 0 keeps every cell. The answer is that of
-        all cells whenever the cells left out carry no load in it.
-    chunk_positions
-        Positions solved in sequence, each from its predecessor (:mod:`fegear.ltca.cycle`); a
-        chunk's first position starts from the default cells. Part of the method: the result
-        depends on it (``hybrid``: within the grid-refinement tolerance; seed face gear, chunks
-        of 7 / 9 / 13: loaded TE p-p 0.4175 / 0.4181 / 0.4177″, chunks of 5: 0.4228″), not on
-        ``workers``. Several chunks per worker balance the load (the positions differ up to 4x
-        in cost); measured warm, 2 workers: face gear 4.6-5.0 s with chunks of 13, 3.8-4.2 s
-        with 7 (9: 4.9-5.7 s, 5: 5.2-5.4 s); spiral bevel 14.9 s with 13, 13.0 s with 7.
+        Name of the loaded :class:`~fegear.ltca.fidelity.Fidelity` (``"fe"``, ``"hertz"``,
+        ``"hybrid"``).
+    g_max_mm, cell_mm, tca_grid, n_across, n_along, max_cells, depth_elements, \
+    depth_max_modules, trim, chunk_positions
+        Tuning of the contact models: :class:`fegear.options.ContactOptions` (the ``[contact]``
+        section of a case), whose defaults and checks these are. Cells much smaller than the P2
+        elements make the FE compliance ``PᵀK⁻¹P`` rank-deficient (more cells than surface DOFs
+        under them), so ``fe`` keeps element-sized cells and only ``hybrid`` refines them to
+        ``n_across`` × ``n_along`` per patch. ``chunk_positions`` is part of the method (each
+        position of a chunk starts from its predecessor: the result depends on it within the
+        grid-refinement tolerance), ``workers`` is not. The measurements behind the defaults:
+        ``benchmarks/results/contact_options.md``.
     workers
         Processes solving the chunks in parallel; None: one per core (at most one per chunk).
     """
@@ -165,37 +118,34 @@ class LTCAOptions:
     n_positions: int = 25
     level: int = 0
     n_teeth: int | None = None
-    cell_mm: float | None = None
-    g_max_mm: float = 0.02
-    tca_grid: tuple[int, int] = (24, 12)
+    cell_mm: float | None = ContactOptions.default("cell_mm")
+    g_max_mm: float = ContactOptions.default("g_max_mm")
+    tca_grid: tuple[int, int] = ContactOptions.default("tca_grid")
     E_MPa: float = 206000.0
     nu: float = 0.3
     backend: str = "auto"
     fidelity: str = "fe"
-    n_across: int = 8
-    n_along: int = 16
-    max_cells: int = 600
-    depth_elements: float = 2.0
-    depth_max_modules: float = 0.35
-    trim: float = 0.3
-    chunk_positions: int = 7
+    n_across: int = ContactOptions.default("n_across")
+    n_along: int = ContactOptions.default("n_along")
+    max_cells: int = ContactOptions.default("max_cells")
+    depth_elements: float = ContactOptions.default("depth_elements")
+    depth_max_modules: float = ContactOptions.default("depth_max_modules")
+    trim: float = ContactOptions.default("trim")
+    chunk_positions: int = ContactOptions.default("chunk_positions")
     workers: int | None = None
 
     def __post_init__(self) -> None:
-        if self.fidelity not in ("fe", "hertz", "hybrid"):
-            raise InputError("fidelity", self.fidelity, "'fe', 'hertz' or 'hybrid'")
-        if not (isinstance(self.chunk_positions, int) and self.chunk_positions >= 1):
-            raise InputError("chunk_positions", self.chunk_positions, "an integer >= 1")
+        fidelity_of(self.fidelity)  # InputError naming the registered fidelities
+        self.contact  # noqa: B018  (InputError naming a bad tuning option)
         if self.workers is not None and not (isinstance(self.workers, int) and self.workers >= 1):
             raise InputError("workers", self.workers, "an integer >= 1, or None for all cores")
-        for name in ("n_across", "n_along", "max_cells"):
-            value = getattr(self, name)
-            if not (isinstance(value, int) and value >= 1):
-                raise InputError(name, value, "an integer >= 1")
-        if not (np.isfinite(self.trim) and self.trim >= 0.0):
-            raise InputError("trim", self.trim, "a finite number >= 0 (0: keep every cell)")
         if self.n_teeth is not None and not (isinstance(self.n_teeth, int) and self.n_teeth >= 1):
             raise InputError("n_teeth", self.n_teeth, "an integer >= 1, or None (automatic)")
+
+    @property
+    def contact(self) -> ContactOptions:
+        """The tuning of the contact models as a :class:`~fegear.options.ContactOptions`."""
+        return ContactOptions(**{n: getattr(self, n) for n in ContactOptions.names()})
 
 
 @dataclass(frozen=True)
@@ -215,6 +165,11 @@ class MemberModels:
     max_cells: int = 600
     zone: ContactZone | None = None
     trim: float = 0.3
+
+    @property
+    def kind(self) -> Fidelity:
+        """The :class:`~fegear.ltca.fidelity.Fidelity` the models were built for."""
+        return fidelity_of(self.fidelity)
 
 
 def cycle_zone(
@@ -263,9 +218,7 @@ def build_models(
     h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
     module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
     depth = layer = 0.0
-    if options.fidelity == "hybrid":
-        depth = min(options.depth_elements * h, options.depth_max_modules * module)
-        layer = depth
+    depth = layer = fidelity_of(options.fidelity).layer_depth(h, module, options)
     models = [
         build_member_model(
             member.name,
@@ -406,14 +359,14 @@ def _solve_cells(tca, pos, models, torque2_Nmm, cell, g_max, warnings, footprint
         if not (models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
             continue  # outside the zone: left_out_pairs reports it if the lag closes it
         su, sv, angle = cell.get((int(g.k), int(g.j)), cell[None])
-        cap = models.max_cells if models.fidelity == "hybrid" else _FE_MAX_CELLS
+        cap = models.kind.max_cells(models)
         c = pair_cells(tca, pos, gi, (su, sv), g_max, max_cells=cap, angle=angle)
         if c is not None:
             cells.append(c)
     if not cells:
         return cells, None, 0.0
     h_max = max(float(c.h.max()) for c in cells)
-    if footprints and models.fidelity == "hybrid":
+    if footprints and models.kind.trims:
         keep = likely_cells(tca.asm, pos.phi1, cells, footprints, models.trim)
         if any(k is not None for k in keep):
             kept = [c if k is None else take_cells(c, k) for c, k in zip(cells, keep, strict=True)]
@@ -464,14 +417,9 @@ def _solve_on(tca, pos, models, torque2_Nmm, cells, footprints, loads=None):
 
 
 def _solve_cells_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
-    """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included)."""
-    if models.fidelity == "hybrid":
-        return hybrid_compliance(tca, pos, models, cells, loads)
-    asm = tca.asm
-    M1 = asm.placement1(pos.phi1)
-    M2 = asm.placement2(pos.phi2)
-    P1, P2 = loads if loads is not None else cell_load_operators(models, M1, M2, cells)
-    return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
+    """``C = C_pinion + C_gear`` of the cells (both flanks, cross-pair coupling included), as
+    the fidelity computes it (:meth:`fegear.ltca.fidelity.Fidelity.compliance`)."""
+    return models.kind.compliance(tca, pos, models, cells, loads)
 
 
 def solve_position(
@@ -496,7 +444,7 @@ def solve_position(
     # no left-out cell could touch.
     g_max = g_max_mm
     cell = {None: (models.cell_mm, models.cell_mm, 0.0)}
-    if models.fidelity == "hybrid" and previous is not None and previous.cells:
+    if models.kind.warm_grids and previous is not None and previous.cells:
         g_max = previous.g_max_mm
         for c in previous.cells:
             cell[(c.k, c.j)] = (float(c.cell_mm[0]), float(c.cell_mm[1]), c.angle)
@@ -536,7 +484,7 @@ def solve_position(
     def modelled(k: int, j: int) -> bool:
         return models.pinion.has_tooth(k) and models.gear.has_tooth(j)
 
-    for _ in range(3 if models.fidelity == "hybrid" else 0):
+    for _ in range(models.kind.refine_rounds):
         lost = missing_pairs(pos, cells, g_max, modelled)
         sizes = refined_sizes(
             cells, sol, cell, models.n_across, missing=lost, n_along=models.n_along

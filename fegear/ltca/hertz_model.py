@@ -192,7 +192,6 @@ def _moment_arm(tca, pos, i: int) -> float:
 
 def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
     """``c = wᵀ C_FE w − wᵀ S w`` on the fe cells within separation ``g_lim`` (see module)."""
-    from fegear.ltca.analysis import _solve_cells_compliance
 
     cells = None
     for grow in (1.0, 4.0, 16.0, 64.0):  # the coarse TCA grid may straddle a thin band
@@ -223,7 +222,7 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False):
             "zone: left out of the lumped compliance"
         )
         cells = take_cells(cells, np.flatnonzero(covered))
-    C = _solve_cells_compliance(tca, pos, models, [cells])
+    C = models.kind.compliance(tca, pos, models, [cells])
     w = np.full(cells.n, 1.0 / cells.n)
     lay = tangent_layout(cells.centers, cells.centers, cells.normals, cells.edges)
     S = 2.0 * layout_influence(lay, 0.0, E, nu)

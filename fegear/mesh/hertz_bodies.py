@@ -36,8 +36,8 @@ import skfem
 from skfem.io.meshio import from_meshio
 
 from fegear.errors import InputError, MeshError
-from fegear.mesh.cache import cached_file
 from fegear.mesh.gmsh_session import initialize as initialize_gmsh
+from fegear.store.cache import cached_file
 
 __all__ = ["BodyMeshSpec", "mesh_block", "mesh_roller", "read_tet_mesh", "roller_height"]
 

@@ -61,7 +61,7 @@ torque on the pair: the teeth bend); the tooth carries the whole load highest on
 little before, where its root stress peaks. ISO's σF0 is the stress of that load case (the whole
 load at the outer point of single contact), so fegear's value is the peak over positions stepping
 back from the rigid point, from the stress sectors under the solved cell forces
-(:func:`fegear.io.gear_run.displacements`). Measured (hybrid, 200 N·m): level 0 pinion 178.0 /
+(:func:`fegear.pipeline.run.displacements`). Measured (hybrid, 200 N·m): level 0 pinion 178.0 /
 183.1 MPa (0.972), gear 169.0 / 177.7 MPa (0.951); level 1 178.6 (0.975) and 168.8 (0.950).
 
 ``python -m fegear.validation.iso6336_root`` prints the rows.
@@ -301,7 +301,7 @@ def _design(member):
 def fzg_reference(case=None) -> dict[str, tuple[RootFactors, float]]:
     """``{"pinion": (factors, σF0), "gear": (factors, σF0)}`` (MPa) of a spur case (default
     ``cases/fzg_spur.toml``) at its torque: ``Ft = 2 T2 / d2``."""
-    from fegear.io.gear_case import build_pair
+    from fegear.pipeline.pair import build_pair
 
     case = case or _fzg_case()
     pair = build_pair(case)
@@ -425,9 +425,9 @@ def fe_root_stress(
     (:func:`single_contact_phi1`, :class:`FERootStress`): one loaded analysis over both windows,
     then one stress solve per member. Returns ``({"pinion": …, "gear": …}, run)`` with
     ``run = (pair, asm, models, cycle, phi2)``."""
-    from fegear.io.gear_case import build_pair
-    from fegear.io.gear_run import displacements
     from fegear.ltca import LTCAOptions, build_models, run_ltca
+    from fegear.pipeline.pair import build_pair
+    from fegear.pipeline.run import displacements
     from fegear.tca.results import ARCSEC
 
     t0 = time.perf_counter()

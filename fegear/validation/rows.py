@@ -278,8 +278,8 @@ def pitch_point_run(fidelity: str = "hybrid", level: int = 0, case=None) -> Pitc
     case
         A spur :class:`~fegear.io.gear_case.GearCase` (its torque, material and backend).
     """
-    from fegear.io.gear_case import build_pair
     from fegear.ltca import LTCAOptions, run_ltca
+    from fegear.pipeline.pair import build_pair
 
     case = case or _case("fzg_spur.toml")
     t0 = time.perf_counter()

@@ -1,7 +1,7 @@
 """Run a gear-pair case: geometry → assembly → (TCA | loaded TCA) → displacement fields.
 
 :func:`run_gear_case` is what ``fegear run`` calls for a gear case; it returns a
-:class:`GearRun` that :func:`fegear.io.gear_output.write_gear_outputs` turns into files.
+:class:`GearRun` that :func:`fegear.output.gear_output.write_gear_outputs` turns into files.
 The library logs; the caller gets progress through an optional callback
 ``progress(stage, i, n)`` (``i``/``n`` are the position counters of the position stage and
 ``None`` otherwise).
@@ -40,15 +40,9 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from fegear.errors import DesignError, InputError
-from fegear.io.gear_case import (
-    FIDELITIES,
-    N_LEVELS,
-    GearCase,
-    GearPair,
-    assemble,
-    build_pair,
-    error_fields,
-)
+from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase, error_fields
+from fegear.ltca.fidelity import Fidelity, fidelity_of
+from fegear.pipeline.pair import GearPair, assemble, build_pair
 
 __all__ = [
     "Engagement",
@@ -336,7 +330,7 @@ class GearRun:
     engagement
         What :func:`check_engagement` found before the analysis.
     cache
-        The artefact-cache lookups of the run (:class:`fegear.mesh.cache.CacheUse`: what was
+        The artefact-cache lookups of the run (:class:`fegear.store.cache.CacheUse`: what was
         read, what was built), or None.
     """
 
@@ -353,6 +347,11 @@ class GearRun:
     @property
     def fidelity(self) -> str:
         return self.case.fidelity
+
+    @property
+    def kind(self) -> Fidelity | None:
+        """The loaded :class:`~fegear.ltca.fidelity.Fidelity` of the run (None: unloaded TCA)."""
+        return None if self.fidelity == UNLOADED else fidelity_of(self.fidelity)
 
     @property
     def phi2(self) -> Array:
@@ -654,7 +653,7 @@ def run_gear_case(
         ``progress(stage, i, n)``: called at the start of each stage (``i = n = None``) and after
         each mesh position (``stage = "positions"``).
     pair
-        The pair of the case if already built (:func:`~fegear.io.gear_case.build_pair`, which
+        The pair of the case if already built (:func:`~fegear.pipeline.pair.build_pair`, which
         is where bad design data is refused).
     workers
         Processes for the mesh positions (:mod:`fegear.ltca.cycle`); None: one per core. A
@@ -672,7 +671,7 @@ def run_gear_case(
     """
     from dataclasses import replace
 
-    from fegear.mesh.cache import record_cache_use
+    from fegear.store.cache import record_cache_use
 
     with record_cache_use() as used:
         run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify)
@@ -695,7 +694,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
     clearance = _check_clearance(case, pair)  # interference: refused before any TCA
     seconds["geometry"] = time.perf_counter() - t0
 
-    if case.fidelity == "tca":
+    if case.fidelity == UNLOADED:
         t0 = time.perf_counter()
         say("tca", None, None)
         opt = TCAOptions(n_positions=case.n_positions, E_MPa=case.E_MPa, nu=case.nu,
@@ -721,6 +720,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         backend=case.backend,
         fidelity=case.fidelity,
         workers=workers,
+        **case.contact.as_dict(),
     )
     t0 = time.perf_counter()
     tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
@@ -749,7 +749,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cycle.zone)
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng)
-    if case.fidelity == "hertz":  # no contact grid: no cell loads, no displacement fields
+    if not fidelity_of(case.fidelity).cells:  # no cell loads: no displacement fields
         return run
     t0 = time.perf_counter()
     say("displacements", None, None)
@@ -869,7 +869,7 @@ def report(run: GearRun) -> Report:
             "left out of the TE peak-to-peak"
         )
     degen = [e for e in h.excluded if e.status == "degenerate"]
-    if run.fidelity == "fe":
+    if run.kind is not None and run.kind.cells and not run.kind.resolves_patch:
         bad = [(q, i) for i, p in enumerate(c.positions) for q in p.pairs if q.in_contact]
         bad = [(q, i) for q, i in bad if not q.resolved]
         if bad:
@@ -883,8 +883,8 @@ def report(run: GearRun) -> Report:
             )
             at = len({i for _, i in bad})
             warnings.append(
-                f"fe: the contact cells ({size} mm) are wider than {patch}) at {at} of {n} "
-                "positions: the pressures and the TE there are cell averages, not the "
+                f"{run.fidelity}: the contact cells ({size} mm) are wider than {patch}) at {at} "
+                f"of {n} positions: the pressures and the TE there are cell averages, not the "
                 "contact's; run --fidelity hybrid (it resolves the patch at every level)"
             )
     if degen:

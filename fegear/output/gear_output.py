@@ -5,13 +5,13 @@ Files written to the output folder (each one atomically: complete or absent):
 - ``summary.json`` — inputs, per position (pinion angle, unloaded/loaded TE, status, pairs with
   force, load share, p_max, patch axes, contact point in the fixed frame, edge flag and edges),
   cycle values, solver residuals, timings, versions, units. Headlines mean what they say
-  (:func:`fegear.io.gear_run.report`): ``cycle.te_pp_loaded_arcsec`` over the usable positions
+  (:func:`fegear.pipeline.run.report`): ``cycle.te_pp_loaded_arcsec`` over the usable positions
   only (``te_pp_loaded_positions_used``; ``excluded_positions`` with their reasons: contact
   lost, or degenerate: a loaded patch the cells do not resolve), ``cycle.p_max_MPa`` the largest
   pressure away from the flank edges, ``cycle.p_max_edge_MPa`` the edge value beside it
   (``p_max_edge_at``: position, pair, edges named), and ``null`` with a ``*_reason`` where
   nothing physical can be reported, never 0. ``pattern`` (per member: the bearing pattern's
-  centre and extent on its flank, :class:`fegear.io.flank_view.PatternCentre`) and ``cache``
+  centre and extent on its flank, :class:`fegear.output.flank_view.PatternCentre`) and ``cache``
   (the cache folder, the artefacts read from it and those built). The engagement checks made
   before the analysis:
   ``cycle.tip_clearance_mm``, ``cycle.unloaded_interior_contact_fraction`` (the contact ratio
@@ -53,7 +53,7 @@ Files written to the output folder (each one atomically: complete or absent):
   ``pinion_tooth``, ``gear_tooth``: the exact solver output. A position without contact has an
   empty file (VTK/ParaView/pyvista read it; meshio 5.3 cannot read an empty VTU).
 - ``vtk/flank_pinion_<i>.vtp``, ``vtk/flank_gear_<i>.vtp`` (fidelities ``fe`` and ``hybrid``)
-  — the flank views (:mod:`fegear.io.flank_view`): the loaded contact cells of each member on
+  — the flank views (:mod:`fegear.output.flank_view`): the loaded contact cells of each member on
   its own working flank in flank coordinates, ``x`` the face coordinate and ``y`` the profile
   coordinate (mm; for the face gear the radius and the height above the pitch plane), cell data
   ``pressure_MPa``, ``force_N``, ``tooth``, ``pair``, ``edge``, with the working-surface
@@ -81,8 +81,8 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from fegear.geometry.transforms import apply_points, apply_vectors
-from fegear.io.files import atomic_write, write_json
-from fegear.io.flank_view import (
+from fegear.io.records import solver_record, versions
+from fegear.output.flank_view import (
     TIME_UNIT,
     FlankFrame,
     FlankPatch,
@@ -92,15 +92,15 @@ from fegear.io.flank_view import (
     pattern_centre,
     write_flank_vtp,
 )
-from fegear.io.gear_run import GearRun, report
-from fegear.io.records import solver_record, versions
+from fegear.pipeline.run import GearRun, report
+from fegear.store.files import atomic_write, write_json
 
 __all__ = ["FlankViews", "flank_views", "write_gear_outputs", "gear_summary", "write_pvd"]
 
 
 @dataclass(frozen=True)
 class FlankViews:
-    """The flank views of a run (:mod:`fegear.io.flank_view`), computed once for the files,
+    """The flank views of a run (:mod:`fegear.output.flank_view`), computed once for the files,
     the summary and the pictures.
 
     Attributes
@@ -275,8 +275,8 @@ def _root_stress_cycle(run: GearRun) -> dict[str, Any]:
     ``cycle.root_stress_fillet_mm``, ``cycle.root_stress_max_equilibrium_residual``; null with
     ``cycle.root_stress_reason`` where the fidelity has no cell loads."""
     if not run.members or not any(mf.root for mf in run.members):
-        if run.fidelity == "hertz":
-            why = "the hertz fidelity has no contact cells: no loads on the sector FE"
+        if run.kind is not None and not run.kind.cells:
+            why = f"the {run.fidelity} fidelity has no contact cells: no loads on the sector FE"
         elif not run.case.root_stress:
             why = (
                 "not computed: [analysis] root_stress = false (the default; --root-stress, "

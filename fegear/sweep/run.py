@@ -4,7 +4,7 @@ A sweep is a list of :class:`SweepItem` (a validated :class:`~fegear.io.gear_cas
 a name and the grid values that made it). :func:`run_sweep` runs every item in its own folder
 ``out/<item>/`` with the outputs of ``fegear run`` (summary.json, VTK + .pvd, PNG), on local
 processes (:class:`concurrent.futures.ProcessPoolExecutor`) or on a Dask distributed cluster, and
-writes the sweep outputs (:mod:`fegear.io.sweep_output`: ``sweep.json``, ``comparison.md``,
+writes the sweep outputs (:mod:`fegear.sweep.output`: ``sweep.json``, ``comparison.md``,
 ``te_overlay.png``).
 
 Grid specification (``KEY=START:STOP:N`` or ``KEY=V1,V2,...``): ``KEY`` is a case-file key
@@ -32,7 +32,7 @@ Robustness (one sweep per output folder at a time; a lock file enforces it on PO
 - an item that fails is reported with its one-line error and does not stop the others.
 
 Dask: the workers need fegear installed and must see ``out`` and the mesh/operator cache
-(:func:`fegear.mesh.cache.cache_root`: ``$FEGEAR_CACHE``, else the per-user cache folder) at the
+(:func:`fegear.store.cache.cache_root`: ``$FEGEAR_CACHE``, else the per-user cache folder) at the
 same paths as the client (a shared file system; a ``LocalCluster`` trivially does).
 """
 
@@ -141,7 +141,7 @@ class SweepItem:
 
     def fingerprint(self) -> str:
         """Hash of everything the item's results depend on (the file it came from excluded)."""
-        from fegear.mesh.cache import content_hash
+        from fegear.store.cache import content_hash
 
         inputs = self.case.to_dict()
         inputs.pop("source", None)
@@ -515,9 +515,9 @@ def run_item(
         each item by the sweep's own workers (1 on a Dask cluster; None: ``$FEGEAR_WORKERS``
         or one per core).
     """
-    from fegear.io.files import write_json
-    from fegear.io.gear_output import write_gear_outputs
-    from fegear.io.gear_run import run_gear_case
+    from fegear.output.gear_output import write_gear_outputs
+    from fegear.pipeline.run import run_gear_case
+    from fegear.store.files import write_json
 
     out = Path(out)
     final = out / item.name
@@ -670,7 +670,7 @@ def run_sweep(
     FegearError
         The scheduler cannot be reached, or another sweep holds the folder.
     """
-    from fegear.io.sweep_output import comparison_error, write_sweep_json, write_sweep_outputs
+    from fegear.sweep.output import comparison_error, write_sweep_json, write_sweep_outputs
 
     items = tuple(items)
     if workers < 1:
@@ -680,7 +680,7 @@ def run_sweep(
         raise InputError("--nominal", nominal, f"one of the item names {names}")
     out = Path(out).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    from fegear.mesh.cache import cache_root as _cache_root
+    from fegear.store.cache import cache_root as _cache_root
 
     # the workers (local processes or Dask) must use this process's cache, wherever they run
     cache_root = str(_cache_root().resolve())

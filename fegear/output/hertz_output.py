@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fegear.io.files import atomic_write, write_json
 from fegear.io.records import solver_record, versions
 from fegear.scenes.hertz_scene import HertzLevelResult, HertzScene
+from fegear.store.files import atomic_write, write_json
 
 __all__ = ["write_hertz_outputs", "hertz_summary", "level_row"]
 

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from fegear import __version__
-from fegear.io.files import atomic_write, write_json
+from fegear.store.files import atomic_write, write_json
 
 __all__ = [
     "TE_FLOOR_ARCSEC",
@@ -121,7 +121,7 @@ def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
 
 def _read_summary(folder: Path) -> dict[str, Any] | None:
     """The item's summary.json, only if it is the complete one its marker vouches for."""
-    from fegear.sweep import verified_summary
+    from fegear.sweep.run import verified_summary
 
     return verified_summary(folder)
 

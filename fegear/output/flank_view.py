@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fegear.io.files import atomic_write
+from fegear.store.files import atomic_write
 
 __all__ = [
     "FlankFrame",
@@ -211,7 +211,7 @@ def _maps(run):
 
 
 def flank_frames(run, maps=None) -> dict[str, FlankFrame]:
-    """The working flank of each member of a :class:`~fegear.io.gear_run.GearRun`."""
+    """The working flank of each member of a :class:`~fegear.pipeline.run.GearRun`."""
     maps = maps or _maps(run)
     out = {}
     for member, fm in maps.items():
@@ -273,7 +273,7 @@ class _Projector:
 
 def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
     """The loaded cells of both members at every position of a loaded
-    :class:`~fegear.io.gear_run.GearRun`, in flank coordinates (empty for the ``hertz``
+    :class:`~fegear.pipeline.run.GearRun`, in flank coordinates (empty for the ``hertz``
     fidelity, which has no contact cells, and at positions without load).
 
     The Newton solves of all cells of all positions run as one batch per member and stage
@@ -406,8 +406,8 @@ def pattern_centre(run, frames=None, patches=None) -> dict[str, PatternCentre]:
             got = [p[member] for p in patches if p[member].force_N.size]
             if not got:
                 why = (
-                    "the hertz fidelity has no contact cells"
-                    if run.fidelity == "hertz"
+                    f"the {run.fidelity} fidelity has no contact cells"
+                    if run.kind is not None and not run.kind.cells
                     else "no loaded cell at any position"
                 )
                 out[member] = PatternCentre(**_none, weighting="cell force", reason=why, **kw)

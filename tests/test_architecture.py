@@ -1,0 +1,169 @@
+"""The package graph of fegear: read from the source (every ``import`` statement, including the
+function-local ones), it has no cycles, and the case-file layer ``fegear.io`` reads and
+validates without reaching into the model layers or the pipeline above them."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "fegear"
+
+#: What ``fegear.io`` must not import: the model layers and everything above it.
+IO_FORBIDDEN = {"ltca", "tca", "scenes", "mesh", "pipeline", "output", "sweep", "api", "cli"}
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _node(module: str) -> str | None:
+    """The graph node of a module: its sub-package or top-level module below ``fegear``
+    (``fegear.ltca.grid`` → ``ltca``, ``fegear.api`` → ``api``); None for the package root
+    (``from fegear import __version__``: the root imports nothing eagerly)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def _imports(path: Path) -> list[tuple[str, int]]:
+    """``[(imported fegear module, line)]`` of one source file, relative imports resolved."""
+    module = _module_name(path)
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out += [(a.name, node.lineno) for a in node.names if a.name.startswith("fegear")]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target == "fegear":  # from fegear import x: x may be a sub-package
+                out += [(f"fegear.{a.name}", node.lineno) for a in node.names]
+            elif target.startswith("fegear."):
+                out.append((target, node.lineno))
+    return out
+
+
+def _graph() -> dict[str, dict[str, list[str]]]:
+    """``{node: {imported node: ["module:line", ...]}}`` over every source file."""
+    graph: dict[str, dict[str, list[str]]] = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        src = _node(_module_name(path))
+        if src is None:
+            continue
+        for target, line in _imports(path):
+            dst = _node(target)
+            if (
+                dst is None
+                or dst == src
+                or not (PACKAGE / dst).exists()
+                and not (PACKAGE / f"{dst}.py").exists()
+            ):
+                continue
+            where = f"{path.relative_to(PACKAGE.parent)}:{line}"
+            graph.setdefault(src, {}).setdefault(dst, []).append(where)
+    return graph
+
+
+def _cycles(graph: dict[str, dict[str, list[str]]]) -> list[list[str]]:
+    """Strongly connected components with more than one node (Tarjan, 1972)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, {}):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_graph_reader_sees_the_known_edges():
+    """The reader is not blind: edges that must exist are found (a broken reader that returns
+    nothing would pass the two tests below)."""
+    g = _graph()
+    assert "ltca" in g["pipeline"]  # the pipeline runs the loaded cycle
+    assert "io" in g["pipeline"]  # ... of a case read by io
+    assert "contact" in g["ltca"]  # the LTCA solves with the contact solver
+    assert "pipeline" in g["output"]  # the writers read a GearRun
+
+
+def test_package_graph_has_no_cycles():
+    g = _graph()
+    cycles = _cycles(g)
+    detail = [
+        f"{a} -> {b}: {', '.join(g[a][b])}"
+        for comp in cycles
+        for a in comp
+        for b in comp
+        if b in g.get(a, {})
+    ]
+    assert not cycles, "package cycles:\n" + "\n".join(detail)
+
+
+@pytest.mark.parametrize("layer", sorted(IO_FORBIDDEN))
+def test_io_does_not_import_upwards(layer):
+    """``fegear.io`` reads case files: it imports nothing from the model layers or above."""
+    edges = _graph().get("io", {})
+    assert layer not in edges, f"fegear.io imports fegear.{layer}: {edges.get(layer)}"
+
+
+def test_contact_solver_knows_nothing_about_gears():
+    """The contact solver and the linear algebra under it import no gear code."""
+    g = _graph()
+    for low in ("contact", "linalg", "store", "errors"):
+        assert set(g.get(low, {})) <= {"errors"}, f"fegear.{low} imports {g.get(low)}"
+
+
+def test_the_case_file_fidelities_are_the_registered_ones():
+    """A fidelity is registered once (:data:`fegear.ltca.fidelity.FIDELITIES`); the case-file
+    choices are those plus the unloaded TCA, and every registered fidelity has the protocol."""
+    from fegear.io.gear_case import FIDELITIES as CHOICES
+    from fegear.io.gear_case import UNLOADED
+    from fegear.ltca.fidelity import FIDELITIES, Fidelity
+
+    assert set(CHOICES) == set(FIDELITIES) | {UNLOADED}
+    for name, fid in FIDELITIES.items():
+        assert fid.name == name
+        for member in Fidelity.__annotations__:
+            assert hasattr(fid, member), f"{name} lacks {member}"
+        for method in ("layer_depth", "max_cells", "compliance", "solve_position"):
+            assert callable(getattr(fid, method)), f"{name}.{method}"
+
+
+def test_the_gear_families_are_the_case_kinds():
+    """A gear family is registered once (:data:`fegear.pipeline.pair.FAMILIES`) for each
+    ``[case] kind`` the schema accepts."""
+    from fegear.io.gear_case import GEAR_KINDS
+    from fegear.pipeline.pair import FAMILIES
+
+    assert set(FAMILIES) == set(GEAR_KINDS)
+    for kind, fam in FAMILIES.items():
+        assert fam.kind == kind
