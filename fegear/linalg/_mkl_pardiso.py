@@ -1,9 +1,14 @@
-"""Minimal ctypes binding to Intel oneMKL PARDISO, for dense Schur complements.
+"""Minimal ctypes binding to Intel oneMKL PARDISO: dense Schur complements and sparse Cholesky.
 
-Only what :func:`fegear.linalg.schur.schur_complement` needs: locate and load ``mkl_rt`` (the same
-search as pypardiso), run PARDISO phase 12 (analysis + numerical factorization) in Schur mode on the
-upper triangle of a real symmetric positive definite matrix, and always release the solver memory
-(phase -1).
+Only what fegear needs: locate and load ``mkl_rt`` (the same search as pypardiso), and on the
+upper triangle of a real symmetric positive definite matrix either
+
+- :meth:`MklPardiso.schur_spd` (for :func:`fegear.linalg.schur.schur_complement`): phase 12
+  (analysis + numerical factorization) in Schur mode, then always phase -1 (release); or
+- :meth:`MklPardiso.factor_spd` (for :func:`fegear.linalg.solve.factorize_spd`): phase 12, the
+  factor kept in PARDISO's handle for any number of phase-33 solves (forward and backward
+  substitution, several right-hand sides at once), released by phase -1 when the
+  :class:`PardisoFactor` is garbage-collected (``weakref.finalize``).
 
 PARDISO settings (oneMKL developer reference, "pardiso iparm Parameter"):
 
@@ -25,6 +30,12 @@ PARDISO settings (oneMKL developer reference, "pardiso iparm Parameter"):
     331–333), which we do not need;
   - ``iparm[26] = 0``: no matrix checker (we build sorted, zero-based CSR ourselves).
 
+  For :meth:`MklPardiso.factor_spd` ``iparm[35] = 0`` (no Schur block) and ``iparm[5] = 0``
+  (the solution goes to ``x``, ``b`` is left alone); the right-hand sides of one phase-33 call
+  are ``nrhs`` contiguous columns of length ``n`` (Fortran order). ``iparm[7] = 2`` refinement
+  steps apply only after perturbed pivots, which ``mtype = 2`` never has (``iparm[6]`` reports
+  the steps done).
+
 - Threads: ``MKL_Set_Num_Threads_Local`` around the call (restored afterwards); ``MKL_NUM_THREADS``
   is honoured when set.
 - The LP64 interface (32-bit ``MKL_INT``) is requested with ``MKL_Set_Interface_Layer``; a process
@@ -33,6 +44,7 @@ PARDISO settings (oneMKL developer reference, "pardiso iparm Parameter"):
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import glob
 import logging
@@ -41,6 +53,8 @@ import site
 import sys
 import threading
 import time
+import weakref
+from collections.abc import Iterator
 from ctypes.util import find_library
 
 import numpy as np
@@ -48,7 +62,7 @@ import scipy.sparse as sp
 
 from fegear.errors import BackendUnavailable, SolverError
 
-__all__ = ["PARDISO_ERRORS", "MklPardiso", "load_library"]
+__all__ = ["PARDISO_ERRORS", "MklPardiso", "PardisoFactor", "load_library"]
 
 logger = logging.getLogger(__name__)
 
@@ -74,6 +88,7 @@ PARDISO_ERRORS: dict[int, str] = {
 _MKL_INTERFACE_LP64 = 0
 _MTYPE_SPD = 2
 _PHASE_ANALYSIS_FACTOR = 12
+_PHASE_SOLVE = 33
 _PHASE_RELEASE_ALL = -1
 _INT32_MAX = np.iinfo(np.int32).max
 
@@ -164,8 +179,11 @@ class MklPardiso:
         perm: np.ndarray,
         iparm: np.ndarray,
         x: np.ndarray,
+        b: np.ndarray | None = None,
+        nrhs: int = 1,
     ) -> int:
-        b = np.zeros(max(n, 1))  # never read in phases 12 / -1
+        if b is None:
+            b = np.zeros(max(n, 1))  # never read in phases 12 / -1
         error = ctypes.c_int32(0)
         self._pardiso(
             pt.ctypes.data,
@@ -178,7 +196,7 @@ class MklPardiso:
             indptr.ctypes.data,
             indices.ctypes.data,
             perm.ctypes.data,
-            ctypes.byref(ctypes.c_int32(1)),  # nrhs
+            ctypes.byref(ctypes.c_int32(nrhs)),
             iparm.ctypes.data,
             ctypes.byref(ctypes.c_int32(0)),  # msglvl: silent
             b.ctypes.data,
@@ -276,10 +294,7 @@ class MklPardiso:
         """
         n = upper.shape[0]
         m = schur_rows.size
-        if upper.nnz > _INT32_MAX or n > _INT32_MAX:
-            raise SolverError(
-                f"PARDISO (LP64): matrix too large for 32-bit indices (n={n}, nnz={upper.nnz})"
-            )
+        _check_lp64(n, upper.nnz)
         data = np.ascontiguousarray(upper.data, dtype=np.float64)
         indptr = np.ascontiguousarray(upper.indptr, dtype=np.int32)
         indices = np.ascontiguousarray(upper.indices, dtype=np.int32)
@@ -310,17 +325,155 @@ class MklPardiso:
                 if previous is not None:
                     self._set_threads_local(previous)
         if err != 0:
-            meaning = PARDISO_ERRORS.get(err, "unknown error code")
-            detail = ""
-            if err == -4 and iparm[29] > 0:
-                detail = f"; first bad pivot at equation {int(iparm[29])}"
-            raise SolverError(
-                f"PARDISO phase 12 (Schur mode) failed: error {err}, {meaning}{detail}"
-            )
+            raise SolverError(f"PARDISO phase 12 (Schur mode) failed: {_explain(err, iparm)}")
         if rel != 0:
             logger.warning("PARDISO memory release (phase -1) returned error %d", rel)
         logger.debug("PARDISO Schur: n=%d m=%d in %.2f s, nnz(L)=%d", n, m, elapsed, int(iparm[17]))
         return x.reshape(m, m)
+
+    def factor_spd(self, upper: sp.csr_matrix, n_threads: int | None) -> PardisoFactor:
+        """Sparse Cholesky factorization ``K = L Lᵀ`` (phase 12, ``mtype = 2``), kept for solves.
+
+        Parameters
+        ----------
+        upper
+            Upper triangle (diagonal included) of the SPD matrix ``K``, CSR, shape ``(n, n)``,
+            float64, sorted column indices.
+        n_threads
+            MKL threads for the factorization and the later solves; ``None`` keeps MKL's
+            setting (``MKL_NUM_THREADS``).
+
+        Returns
+        -------
+        PardisoFactor
+            The factor; its PARDISO memory is released (phase -1) when it is garbage-collected.
+
+        Raises
+        ------
+        SolverError
+            PARDISO reported an error (the message gives the code and its meaning), e.g. -4 for
+            a matrix that is not positive definite.
+        """
+        n = upper.shape[0]
+        _check_lp64(n, upper.nnz)
+        data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        indptr = np.ascontiguousarray(upper.indptr, dtype=np.int32)
+        indices = np.ascontiguousarray(upper.indices, dtype=np.int32)
+        perm = np.zeros(n, dtype=np.int32)  # not read: iparm[4] = 0, iparm[35] = 0
+        pt = np.zeros(64, dtype=np.int64)
+        iparm = np.zeros(64, dtype=np.int32)
+        self._pardisoinit(
+            pt.ctypes.data, ctypes.byref(ctypes.c_int32(_MTYPE_SPD)), iparm.ctypes.data
+        )
+        iparm[26] = 0  # matrix checker off: CSR built here, sorted and zero-based
+        iparm[34] = 1  # zero-based ia / ja
+        iparm[5] = 0  # solution in x, b unchanged
+        arrays = (data, indptr, indices, perm)
+        with self._lock, self._threads(n_threads):
+            t0 = time.perf_counter()
+            err = self._call(pt, _PHASE_ANALYSIS_FACTOR, n, *arrays, iparm, np.zeros(1))
+            elapsed = time.perf_counter() - t0
+            if err != 0:
+                self._release(pt, n, arrays, iparm)
+        if err != 0:
+            raise SolverError(
+                f"PARDISO phase 12 (Cholesky factorization) failed: {_explain(err, iparm)}"
+            )
+        logger.debug(
+            "PARDISO Cholesky: n=%d nnz(upper)=%d in %.2f s, nnz(L)=%d",
+            n,
+            upper.nnz,
+            elapsed,
+            int(iparm[17]),
+        )
+        return PardisoFactor(self, n, pt, iparm, arrays, n_threads)
+
+    @contextlib.contextmanager
+    def _threads(self, n_threads: int | None) -> Iterator[None]:
+        """MKL threads of the calling thread set to ``n_threads`` inside the block (``None``:
+        MKL's setting), restored afterwards."""
+        previous = self._set_threads_local(int(n_threads)) if n_threads else None
+        try:
+            yield
+        finally:
+            if previous is not None:
+                self._set_threads_local(previous)
+
+    def _release(self, pt: np.ndarray, n: int, arrays: tuple[np.ndarray, ...], iparm) -> None:
+        """Phase -1: free all PARDISO memory of the handle ``pt`` (caller holds the lock)."""
+        rel = self._call(pt, _PHASE_RELEASE_ALL, n, *arrays, iparm, np.zeros(1))
+        if rel != 0:
+            logger.warning("PARDISO memory release (phase -1) returned error %d", rel)
+
+
+class PardisoFactor:
+    """A PARDISO Cholesky factor (the handle ``pt`` of :meth:`MklPardiso.factor_spd`).
+
+    Holds the matrix arrays PARDISO was given (phase 33 reads them again) and releases the
+    solver memory (phase -1) once, when garbage-collected or on :meth:`release`.
+    """
+
+    def __init__(
+        self,
+        lib: MklPardiso,
+        n: int,
+        pt: np.ndarray,
+        iparm: np.ndarray,
+        arrays: tuple[np.ndarray, ...],
+        n_threads: int | None,
+    ) -> None:
+        self.n = n
+        self._lib = lib
+        self._pt = pt
+        self._iparm = iparm
+        self._arrays = arrays
+        self._n_threads = n_threads
+        self._finalizer = weakref.finalize(self, _release_locked, lib, pt, n, arrays, iparm)
+
+    def solve(self, B: np.ndarray) -> np.ndarray:
+        """Phase 33 on ``B`` of shape ``(n, k)``: returns ``X`` with ``K X = B``, shape ``(n, k)``.
+
+        Raises
+        ------
+        SolverError
+            PARDISO reported an error, or the factor was released.
+        """
+        if not self._finalizer.alive:
+            raise SolverError("PARDISO factor used after its memory was released")
+        n, k = B.shape
+        b = np.asfortranarray(B, dtype=np.float64)  # read only (iparm[5] = 0)
+        x = np.zeros((n, k), dtype=np.float64, order="F")
+        iparm = self._iparm.copy()  # phase 33 writes outputs (iparm[6]); keep the factor's own
+        with self._lib._lock, self._lib._threads(self._n_threads):
+            err = self._lib._call(self._pt, _PHASE_SOLVE, n, *self._arrays, iparm, x, b=b, nrhs=k)
+        if err != 0:
+            raise SolverError(f"PARDISO phase 33 (solve) failed: {_explain(err, iparm)}")
+        return x
+
+    def release(self) -> None:
+        """Free PARDISO's memory now (phase -1); later solves raise :class:`SolverError`."""
+        self._finalizer()
+
+
+def _release_locked(
+    lib: MklPardiso, pt: np.ndarray, n: int, arrays: tuple[np.ndarray, ...], iparm: np.ndarray
+) -> None:
+    with lib._lock:
+        lib._release(pt, n, arrays, iparm)
+
+
+def _explain(err: int, iparm: np.ndarray) -> str:
+    """``"error -4, zero or negative pivot ..."``: PARDISO's code, its meaning, the bad pivot."""
+    meaning = PARDISO_ERRORS.get(err, "unknown error code")
+    detail = ""
+    if err == -4 and iparm[29] > 0:
+        detail = f"; first bad pivot at equation {int(iparm[29])}"
+    return f"error {err}, {meaning}{detail}"
+
+
+def _check_lp64(n: int, nnz: int) -> None:
+    if nnz > _INT32_MAX or n > _INT32_MAX:
+        raise SolverError(f"PARDISO (LP64): matrix too large for 32-bit indices (n={n}, nnz={nnz})")
 
 
 def _workspace(S: np.ndarray, overwrite: bool) -> np.ndarray:

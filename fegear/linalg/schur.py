@@ -68,6 +68,7 @@ __all__ = [
     "BACKENDS",
     "ENV_SOLVER",
     "available_backends",
+    "check_spd_matrix",
     "requested_backend",
     "resolve_backend",
     "schur_complement",
@@ -97,7 +98,8 @@ _pardiso_state: tuple[_mkl_pardiso.MklPardiso | None, str] | None = None
 
 
 def _self_check(lib: _mkl_pardiso.MklPardiso) -> None:
-    """Schur complement of a 6×6 SPD tridiagonal matrix against the dense formula."""
+    """Schur complement of a 6×6 SPD tridiagonal matrix against the dense formula, and a
+    Cholesky factor + solve against the dense solve."""
     n = 6
     K = sp.diags([-np.ones(n - 1), 4.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
     c = np.array([1, 4])
@@ -106,12 +108,18 @@ def _self_check(lib: _mkl_pardiso.MklPardiso) -> None:
     expected = Kd[np.ix_(c, c)] - Kd[np.ix_(c, i)] @ np.linalg.solve(
         Kd[np.ix_(i, i)], Kd[np.ix_(i, c)]
     )
-    got = lib.schur_spd(sp.triu(K, format="csr"), c, n_threads=1)
+    upper = sp.triu(K, format="csr")
+    got = lib.schur_spd(upper, c, n_threads=1)
     # Well-conditioned 6×6 matrix with O(1) entries: the two agree to round-off (~1e-16).
     if not np.allclose(got, expected, rtol=1e-12, atol=1e-12):
         raise SolverError(
             f"PARDISO self-check failed: got {got.tolist()}, want {expected.tolist()}"
         )
+    # The plain Cholesky factor and solve (fegear.linalg.solve), two right-hand sides.
+    B = np.stack([np.arange(1.0, n + 1.0), np.ones(n)], axis=1)
+    x = lib.factor_spd(upper, n_threads=1).solve(B)
+    if not np.allclose(x, np.linalg.solve(Kd, B), rtol=1e-12, atol=1e-12):
+        raise SolverError(f"PARDISO self-check failed: solve gave {x.tolist()}")
 
 
 def _pardiso() -> tuple[_mkl_pardiso.MklPardiso | None, str]:
@@ -208,6 +216,22 @@ def resolve_backend(name: str = "auto") -> str:
 
 def _check_inputs(K: object, idx: object) -> tuple[sp.csr_matrix, np.ndarray]:
     """Validate ``K`` (sparse, square, real, symmetric) and ``idx`` (unique, in range)."""
+    n = _check_shape(K)
+    arr = _check_idx(idx, n)
+    known = _LAST_K.get("K")
+    if known is not None and known[0]() is K and known[1] == K.nnz:
+        return known[2], arr  # validated by the previous call (a body's K: one per operator)
+    Kc = check_spd_matrix(K)
+    try:
+        _LAST_K["K"] = (weakref.ref(K, _forget_k), K.nnz, Kc)
+        _LAST_K.pop("upper", None)
+    except TypeError:  # an object without weak references: checked every time
+        _LAST_K.clear()
+    return Kc, arr
+
+
+def _check_shape(K: object) -> int:
+    """``n`` of a sparse, square, non-empty, real ``K`` (:class:`InputError` otherwise)."""
     if not sp.issparse(K):
         raise InputError("K", type(K).__name__, "a scipy.sparse matrix")
     if K.ndim != 2 or K.shape[0] != K.shape[1] or K.shape[0] == 0:
@@ -216,11 +240,23 @@ def _check_inputs(K: object, idx: object) -> tuple[sp.csr_matrix, np.ndarray]:
         np.issubdtype(K.dtype, np.floating) or np.issubdtype(K.dtype, np.integer)
     ):
         raise InputError("K.dtype", str(K.dtype), "real")
-    n = K.shape[0]
-    arr = _check_idx(idx, n)
-    known = _LAST_K.get("K")
-    if known is not None and known[0]() is K and known[1] == K.nnz:
-        return known[2], arr  # validated by the previous call (a body's K: one per operator)
+    return K.shape[0]
+
+
+def check_spd_matrix(K: object) -> sp.csr_matrix:
+    """``K`` as canonical CSR float64 (a copy where conversion is needed; the caller's matrix is
+    never modified), checked: sparse, square, non-empty, real, finite, positive diagonal (every
+    diagonal entry stored, as PARDISO needs), symmetric to ``_SYMMETRY_RTOL``.
+
+    Positive definiteness itself is left to the factorization (PARDISO error -4, a SuperLU zero
+    pivot).
+
+    Raises
+    ------
+    InputError
+        Any of the checks fails; the message names it.
+    """
+    _check_shape(K)
     Kc = sp.csr_matrix(K, dtype=np.float64)
     if not Kc.has_canonical_format:  # copy first: never modify the caller's matrix in place
         Kc = Kc.copy()
@@ -242,12 +278,7 @@ def _check_inputs(K: object, idx: object) -> tuple[sp.csr_matrix, np.ndarray]:
     asym_max = float(asym.data.max()) if asym.nnz else 0.0
     if asym_max > _SYMMETRY_RTOL * scale:
         raise InputError("K", f"max|K - Kᵀ| = {asym_max:.3g} (max|K| = {scale:.3g})", "symmetric")
-    try:
-        _LAST_K["K"] = (weakref.ref(K, _forget_k), K.nnz, Kc)
-        _LAST_K.pop("upper", None)
-    except TypeError:  # an object without weak references: checked every time
-        _LAST_K.clear()
-    return Kc, arr
+    return Kc
 
 
 #: The last matrix :func:`_check_inputs` validated (``"K"``: a weak reference to the caller's

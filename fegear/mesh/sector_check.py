@@ -15,6 +15,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.linalg.solve import factorize_spd
+
 from .sector import SectorMesh
 from .sector_geometry import SectorFrame
 
@@ -48,9 +50,13 @@ def tooth_compliance(
     radius: float | None = None,
     E: float = 206000.0,
     nu: float = 0.3,
+    backend: str = "auto",
 ) -> float:
-    """Deflection (mm) along a unit normal load at the pitch point of the centre tooth."""
-    from scipy.sparse.linalg import spsolve
+    """Deflection (mm) along a unit normal load at the pitch point of the centre tooth.
+
+    ``backend``: the sparse SPD solver (``"auto"``, ``"pardiso"``, ``"superlu"``), see
+    :func:`fegear.linalg.solve.factorize_spd`.
+    """
     from skfem import (
         Basis,
         ElementTetP2,
@@ -63,10 +69,6 @@ def tooth_compliance(
     )
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    try:
-        from pypardiso import spsolve as psolve
-    except ImportError:  # pragma: no cover - platform dependent
-        psolve = spsolve
     m = mesh.to_skfem()
     p0, n0 = pitch_point(frame)
     a = radius if radius is not None else frame.module
@@ -89,5 +91,5 @@ def tooth_compliance(
     D = np.concatenate([ib.get_dofs(name).all() for name in fixed])
     u = np.zeros(K.shape[0])
     Kc, fc, _, I = condense(K, f, D=D)
-    u[I] = psolve(Kc.tocsr(), fc)
+    u[I] = factorize_spd(Kc, backend).solve(fc)
     return float(f @ u)

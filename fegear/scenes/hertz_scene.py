@@ -46,6 +46,7 @@ from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body
 from fegear.halfspace import subsurface_influence
 from fegear.hertz import HertzPoint, hertz_point_radii
+from fegear.linalg.solve import factorize_spd
 from fegear.mesh.hertz_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh, roller_height
 from fegear.patch import measure_patch
 
@@ -483,9 +484,10 @@ def run_level(
 
 
 def _body_field(name: str, body: ElasticBody, f: np.ndarray, backend: str) -> BodyField:
-    """Displacement of a body under the contact forces (one sparse solve on the free DOFs)."""
+    """Displacement of a body under the contact forces (one sparse SPD solve on the free DOFs,
+    :func:`fegear.linalg.solve.factorize_spd` with the scene's backend)."""
     u = np.zeros(body.n_dofs)
-    u[body.free] = _solve_spd(body.K, f[body.free], backend)
+    u[body.free] = factorize_spd(body.K, backend).solve(f[body.free])
     nv = body.mesh.p.shape[1]
     disp = u[: 3 * nv].reshape(nv, 3)
     return BodyField(
@@ -495,16 +497,3 @@ def _body_field(name: str, body: ElasticBody, f: np.ndarray, backend: str) -> Bo
         displacement=disp,
         dofs=body.n_dofs,
     )
-
-
-def _solve_spd(K, f: np.ndarray, backend: str) -> np.ndarray:
-    """One sparse SPD solve with the chosen backend (PARDISO through pypardiso, or SuperLU)."""
-    from fegear.linalg import resolve_backend
-
-    if resolve_backend(backend) == "pardiso":
-        import pypardiso
-
-        return np.asarray(pypardiso.spsolve(K.tocsr(), f))
-    import scipy.sparse.linalg as spla
-
-    return spla.splu(K.tocsc()).solve(f)
