@@ -254,35 +254,8 @@ def build_models(
 
 
 def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
-    from fegear.contact import ContactSolution
-
-    empty = ContactSolution(
-        force=np.zeros(0),
-        gap=np.zeros(0),
-        active=np.zeros(0, dtype=bool),
-        theta=0.0,
-        iterations=0,
-        equilibrium_residual=0.0,
-        complementarity_residual=0.0,
-        max_penetration=0.0,
-        min_active_force=0.0,
-    )
-    te = pos.te_arcsec
-    return LoadedPosition(
-        phi1=pos.phi1,
-        te_unloaded_arcsec=te,
-        te_loaded_arcsec=te,
-        theta=0.0,
-        pairs=(),
-        cells=(),
-        pressure=(),
-        solution=empty,
-        g_max_mm=0.0,
-        warnings=(reason,),
-        status="lost",
-        status_reason=reason,
-        unloaded_contact=bool(pos.has_contact),
-    )
+    """The TCA position ``pos`` as a position that carries no load (``reason``: why)."""
+    return LoadedPosition.lost(pos.phi1, pos.te_arcsec, bool(pos.has_contact), reason)
 
 
 def _edge_split(c: PairCells, act, p, semi_minor: float, b1, b2):

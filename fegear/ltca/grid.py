@@ -169,8 +169,26 @@ def tca_edge_names(edge: str, bounds1, bounds2) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _separation(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
-    """Separations of pinion-flank points ``(U, V)`` of pair ``i`` (as ``TCA._grids``)."""
+def separation_at(tca: TCA, phi1: float, ts: float, i: int, U: Array, V: Array):
+    """Separations of pinion-flank points ``(U, V)`` (flank parameters, any shape ``S``) of TCA
+    pair ``i`` at pinion angle ``phi1`` with the gear turned back by ``ts`` (rad), as the TCA's
+    own separation grids compute them: each point is carried into the gear's tooth frame and
+    its normal line intersected with the gear flank.
+
+    Returns
+    -------
+    X, N
+        ``S + (3,)``: the points and unit normals in the world frame (mm).
+    s
+        ``S``: separation along the normal (mm; 0 where ``ok`` is False).
+    h
+        ``S``: moment arm of the gear rotation along the normal (mm/rad): a rigid turn ``θ``
+        of the gear closes the separation by ``θ h``.
+    ok
+        ``S``: the normal line meets the gear's working flank with ``h > 0``.
+    gear_uv
+        ``S + (2,)``: the gear-flank parameters of the hit points.
+    """
     a = tca.asm
     fm1, fm2 = tca.fm1, tca.fm2
     _, _, P, N = fm1.native_point(U, V)
@@ -332,7 +350,7 @@ def pair_cells(
         X, N = np.full(shp + (3,), np.nan), np.full(shp + (3,), np.nan)
         s, h, guv = np.full(shp, np.inf), np.zeros(shp), np.zeros(shp + (2,))
         ok = np.zeros(shp, dtype=bool)
-        Xi, Ni, si, hi_, oki, guvi = _separation(
+        Xi, Ni, si, hi_, oki, guvi = separation_at(
             tca, pos.phi1, -pos.te_rad, i, CU[inside], CV[inside]
         )
         X[inside], N[inside], s[inside], h[inside], ok[inside], guv[inside] = (

@@ -40,7 +40,7 @@ from scipy.optimize import brentq
 from fegear.contact import ContactSolution
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
-from fegear.ltca.grid import _separation, pair_cells, take_cells, tca_edge_names
+from fegear.ltca.grid import pair_cells, separation_at, take_cells, tca_edge_names
 from fegear.ltca.results import LoadedPosition, PairLoad
 from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
@@ -93,7 +93,7 @@ def _hessian(tca: TCA, pos: PositionResult, i: int, step_mm: float):
     dv_probe = 1e-4 * (b.v_end - b.v_start)
     uu = np.array([u0, u0 + du_probe, u0])
     vv = np.array([v0, v0, v0 + dv_probe])
-    X, N, _, _, _, _ = _separation(tca, pos.phi1, -pos.te_rad, i, uu, vv)
+    X, N, _, _, _, _ = separation_at(tca, pos.phi1, -pos.te_rad, i, uu, vv)
     lu = np.linalg.norm(X[1] - X[0]) / du_probe
     lv = np.linalg.norm(X[2] - X[0]) / dv_probe
     hu, hv = step_mm / lu, step_mm / lv
@@ -101,7 +101,7 @@ def _hessian(tca: TCA, pos: PositionResult, i: int, step_mm: float):
     V = v0 + hv * np.array([-1, -1, -1, 0, 0, 0, 1, 1, 1], dtype=float)
     U = np.clip(U, b.u_fillet, b.u_tip)
     V = np.clip(V, b.v_start, b.v_end)
-    X, N, s, h, ok, _ = _separation(tca, pos.phi1, -pos.te_rad, i, U, V)
+    X, N, s, h, ok, _ = separation_at(tca, pos.phi1, -pos.te_rad, i, U, V)
     if not ok[4] or ok.sum() < 6:  # at a flank edge: keep the points that meet the gear flank
         return None
     # Local coordinates in the tangent plane at the centre (oblique u, v handled exactly).
@@ -186,7 +186,7 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=None):
 def _moment_arm(tca, pos, i: int) -> float:
     """Moment arm ``h`` of pair ``i`` at its closest point."""
     u0, v0 = pos.pinion_uv[i]
-    _, _, _, h, _, _ = _separation(tca, pos.phi1, -pos.te_rad, i, np.array([u0]), np.array([v0]))
+    _, _, _, h, _, _ = separation_at(tca, pos.phi1, -pos.te_rad, i, np.array([u0]), np.array([v0]))
     return float(h[0])
 
 
@@ -276,12 +276,14 @@ def _lag(laws, torque2_Nmm: float) -> float:
     return float(brentq(residual, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS))
 
 
+def _lost(pos: PositionResult, reason: str) -> LoadedPosition:
+    return LoadedPosition.lost(pos.phi1, pos.te_arcsec, bool(pos.has_contact), reason)
+
+
 def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> LoadedPosition:
     """Load sharing at one position with the ``hertz`` fidelity (see the module docstring)."""
-    from fegear.ltca.analysis import _no_contact
-
     if not pos.has_contact:
-        return _no_contact(pos, "no contact: the flanks do not meet at this position")
+        return _lost(pos, "no contact: the flanks do not meet at this position")
     # Pairs farther from contact than the sectors' contact zone reaches get their law only if the
     # solved lag closes them: the compliance operators cover the flanks of the zone's teeth only
     # (fegear.ltca.model), and a law's lumped compliance reads the FE at the pair's
@@ -290,7 +292,7 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
     near = {gi for gi, g in enumerate(pos.grids) if _backlash(tca, pos, g) <= reach}
     laws, warnings = pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=near)
     if not laws:
-        return _no_contact(pos, "no pair with a Hertz law at this position")
+        return _lost(pos, "no pair with a Hertz law at this position")
     far = [gi for gi in range(len(pos.grids)) if gi not in near]
     while True:
         theta = _lag(laws, torque2_Nmm)

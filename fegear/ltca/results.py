@@ -180,6 +180,37 @@ class LoadedPosition:
     status_reason: str = ""
     unloaded_contact: bool = True
 
+    @classmethod
+    def lost(cls, phi1: float, te_unloaded_arcsec: float, unloaded_contact: bool, reason: str):
+        """A position that carries no load (status ``"lost"``, ``reason`` why): no pairs, an
+        empty contact solution, the loaded TE equal to the unloaded one."""
+        empty = ContactSolution(
+            force=np.zeros(0),
+            gap=np.zeros(0),
+            active=np.zeros(0, dtype=bool),
+            theta=0.0,
+            iterations=0,
+            equilibrium_residual=0.0,
+            complementarity_residual=0.0,
+            max_penetration=0.0,
+            min_active_force=0.0,
+        )
+        return cls(
+            phi1=phi1,
+            te_unloaded_arcsec=te_unloaded_arcsec,
+            te_loaded_arcsec=te_unloaded_arcsec,
+            theta=0.0,
+            pairs=(),
+            cells=(),
+            pressure=(),
+            solution=empty,
+            g_max_mm=0.0,
+            warnings=(reason,),
+            status="lost",
+            status_reason=reason,
+            unloaded_contact=unloaded_contact,
+        )
+
     @property
     def n_pairs_in_contact(self) -> int:
         return sum(p.in_contact for p in self.pairs)
