@@ -10,8 +10,8 @@ Fidelities (DESIGN §9) available for gear pairs:
 
 - ``"fe"``: :func:`fegear.ltca.run_ltca` (FE sector compliance, torque-balanced contact);
   then, per member, the displacement ``u = K⁻¹ P F`` of every position in ONE factorisation
-  (all positions are the columns of one right-hand side; MKL PARDISO through ``pypardiso``
-  where installed, else SciPy SuperLU).
+  (all positions are the columns of one right-hand side; one sparse Cholesky,
+  :func:`fegear.linalg.solve.factorize_spd`, with the case's ``backend``).
 - ``"tca"``: the rigid, unloaded TCA (:func:`fegear.tca.run_tca`): unloaded TE, contact path,
   unloaded bearing pattern. No FE, no loaded results.
 
@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 
 from fegear.errors import DesignError, InputError
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase, error_fields
+from fegear.linalg.solve import SparseFactor, factorize_spd
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.pipeline.pair import GearPair, assemble, build_pair
 
@@ -86,7 +87,7 @@ class MemberField:
     placements
         ``(n_positions, 4, 4)`` member frame → fixed frame at each position.
     solver
-        Sparse backend of the displacement solve (``"pypardiso"`` or ``"superlu"``).
+        Sparse backend of the displacement solve (``"pardiso"`` or ``"superlu"``).
     max_principal, min_principal, von_mises
         ``(n_positions, n)`` MPa, recovered vertex stresses (:mod:`fegear.fem.stress`: element
         values at the vertices, averaged); zeros at positions without contact.
@@ -377,53 +378,29 @@ def _override(case: GearCase, fidelity: str | None, level: int | None) -> GearCa
     )
 
 
-def _linear_solver(K: sp.csr_matrix) -> tuple[Callable[[Array], Array], str]:
-    """A solver of ``K X = B`` (``K`` symmetric positive definite) for several right-hand sides
-    (one factorisation): PARDISO's Cholesky (``mtype = 2``, the upper triangle) where
-    ``pypardiso`` is installed, measured 30 s against 52 s for its default LU (``mtype = 11``)
-    on a 192k-DOF stress sector of the FZG pinion (2 busy cores, residuals 3e-14 / 2e-14)."""
-    try:
-        import pypardiso
-
-        solver = pypardiso.PyPardisoSolver(mtype=2)
-        upper = sp.triu(K, format="csr")
-        upper.sort_indices()
-        solver.factorize(upper)  # kept: a later solve with the same matrix back-substitutes
-
-        def solve(B: Array) -> Array:
-            return np.asarray(solver.solve(upper, np.ascontiguousarray(B))).reshape(B.shape)
-
-        return solve, "pypardiso"
-    except Exception:  # noqa: BLE001  (pypardiso or MKL missing: the portable fallback)
-        import scipy.sparse.linalg as sla
-
-        lu = sla.splu(K.tocsc())
-        return lu.solve, "superlu"
-
-
 #: Factorised stress sectors kept in the process (the last pair): runs of the same pair in one
 #: process (sweeps, scripts, the test session) solve by back-substitution only. A 190k-DOF FZG
 #: stress sector's Cholesky is some hundred MB, hence two.
-_FACTORS: OrderedDict[tuple, tuple[sp.csr_matrix, Callable[[Array], Array], str]] = OrderedDict()
+_FACTORS: OrderedDict[tuple, tuple[sp.csr_matrix, SparseFactor]] = OrderedDict()
 _MAX_FACTORS = 2
 
 
-def _factorised(sector, body) -> tuple[sp.csr_matrix, Callable[[Array], Array], str]:
-    """``(K_full, solve, backend)`` of a stress sector: the full stiffness (reactions) and the
+def _factorised(sector, body, backend: str = "auto") -> tuple[sp.csr_matrix, SparseFactor]:
+    """``(K_full, factor)`` of a stress sector: the full stiffness (reactions) and the
     solver on its free DOFs, from :data:`_FACTORS` when the same mesh (file), material and
     clamping were factorised before in this process."""
     from fegear.fem.assembly import elasticity_stiffness
 
-    key = (str(sector.path), body.E, body.nu, body.free.size, body.n_dofs)
+    key = (str(sector.path), body.E, body.nu, body.free.size, body.n_dofs, backend)
     if key in _FACTORS:
         _FACTORS.move_to_end(key)
         return _FACTORS[key]
     K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
-    solve, used = _linear_solver(K[body.free][:, body.free].tocsr())
-    _FACTORS[key] = (K, solve, used)
+    factor = factorize_spd(K[body.free][:, body.free].tocsr(), backend)
+    _FACTORS[key] = (K, factor)
     while len(_FACTORS) > _MAX_FACTORS:
         _FACTORS.popitem(last=False)
-    return K, solve, used
+    return K, factor
 
 
 def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
@@ -485,6 +462,7 @@ def displacements(
     refine_teeth: dict[str, tuple[int, ...]] | None = None,
     keep_dofs: bool = False,
     root_stress: bool = True,
+    backend: str = "auto",
 ) -> tuple[MemberField, ...]:
     """Displacement and stress of both stress sectors at every position: ``u = K⁻¹ P F``.
 
@@ -506,6 +484,7 @@ def displacements(
     ``root_stress`` False: the displacement on the contact sectors themselves (no remeshing, the
     factorisation of a sector of the contact model's size), without stresses (the contact
     sectors' fillets are as coarse as their level: their stresses are not the root stress).
+    ``backend``: of the sparse Cholesky (:func:`fegear.linalg.solve.factorize_spd`).
     """
     from fegear.fem.stress import (
         CONTACT_CLEARANCE_MODULES,
@@ -564,10 +543,9 @@ def displacements(
         loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
         K = None
         if loaded.size:
-            K, solve, used = _factorised(smodel.sector, body)
-            full[body.free] = np.asarray(solve(np.ascontiguousarray(F[body.free]))).reshape(
-                body.free.size, n_pos
-            )
+            K, factor = _factorised(smodel.sector, body, backend)
+            used = factor.backend
+            full[body.free] = factor.solve(np.ascontiguousarray(F[body.free]))
             U = np.transpose(full[vdofs], (2, 0, 1))
         teeth = model.teeth if model.teeth is not None else None
         regions = fillet_regions(smodel.sector, model.side, teeth) if root_stress else ()
@@ -753,7 +731,9 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         return run
     t0 = time.perf_counter()
     say("displacements", None, None)
-    members = displacements(pair, asm, models, cycle, run.phi2, root_stress=case.root_stress)
+    members = displacements(
+        pair, asm, models, cycle, run.phi2, root_stress=case.root_stress, backend=case.backend
+    )
     seconds["displacements"] = time.perf_counter() - t0
     return GearRun(
         case=case,
