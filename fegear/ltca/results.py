@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -343,8 +344,10 @@ class LoadedCycle:
         ``g_max`` when the load made the zone grow, :func:`fegear.ltca.cycle.grown_zone`); 0 for
         models without a zone.
     zone
-        That contact zone (:class:`fegear.ltca.zone.ContactZone`; the models of the cycle are
-        ``build_models(..., zone=zone)``, read back from the cache), or None.
+        That contact zone (:class:`fegear.ltca.zone.ContactZone`), or None.
+    models
+        The :class:`fegear.ltca.analysis.MemberModels` every position was solved on (those of
+        ``zone``): what the displacement fields load, without building them again.
     """
 
     positions: tuple[LoadedPosition, ...]
@@ -359,6 +362,7 @@ class LoadedCycle:
     phase2: float = 0.0
     zone_gap_mm: float = 0.0
     zone: ContactZone | None = None
+    models: Any = None
 
     @property
     def te_pp_unloaded_arcsec(self) -> float:

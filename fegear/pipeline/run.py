@@ -722,9 +722,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         progress=lambda i, n: say("positions", i, n),
     )
     seconds["positions"] = time.perf_counter() - t0
-    if cycle.zone is not None and cycle.zone is not models.zone:
-        # the load grew the contact zone: the cycle ran on other sectors (cached, read back)
-        models = build_models(pair.pinion, pair.gear, pair.assembly, opt, zone=cycle.zone)
+    models = cycle.models  # those of the grown zone if the load made it grow
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng)
     if not fidelity_of(case.fidelity).cells:  # no cell loads: no displacement fields
