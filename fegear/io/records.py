@@ -9,8 +9,8 @@ from fegear.contact import ContactSolution
 
 __all__ = ["solver_record", "versions"]
 
-#: Recorded in every summary; ``pyvista`` (extra ``view``) and ``mkl`` (extra ``pardiso``) are
-#: optional, recorded as ``"not installed"`` where absent.
+#: Recorded in every summary; ``pyvista`` (extra ``view``) and ``mkl`` (x86-64 only) may be
+#: absent: ``"not installed"``.
 _PACKAGES = ("fegear", "numpy", "scipy", "scikit-fem", "gmsh", "meshio", "pyvista", "matplotlib",
              "mkl")  # fmt: skip
 
