@@ -126,7 +126,7 @@ else:
 
 
 def test_versions_record_absent_packages(monkeypatch) -> None:
-    from fegear.io import records
+    from fegear.output import records
 
     real = importlib.metadata.version
 

@@ -81,7 +81,6 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from fegear.geometry.transforms import apply_points, apply_vectors
-from fegear.io.records import solver_record, versions
 from fegear.output.flank_view import (
     TIME_UNIT,
     FlankFrame,
@@ -92,6 +91,7 @@ from fegear.output.flank_view import (
     pattern_centre,
     write_flank_vtp,
 )
+from fegear.output.records import solver_record, versions
 from fegear.pipeline.run import GearRun, report
 from fegear.store.files import atomic_write, write_json
 
