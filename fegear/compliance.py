@@ -27,7 +27,7 @@ Only its columns on the DOFs that cells load (the flank) are ever needed: the ot
 ``(K^{-1})_{cf}``, ``f ⊂ c`` (:func:`fegear.linalg.inverse_columns`, ~40 % less work than the
 square block on the seed face gear's pinion). The block depends only on the mesh, material,
 clamped DOFs, ``c`` and ``f``; it is cached on disk under a content hash of those
-(:mod:`fegear.mesh.cache`), so a second run, or another grid on the same candidate region, costs
+(:mod:`fegear.store.cache`), so a second run, or another grid on the same candidate region, costs
 only the sparse products.
 """
 
@@ -50,7 +50,7 @@ from scipy.spatial import cKDTree
 from fegear.errors import InputError, SolverError
 from fegear.fem.elasticity import ElasticBody
 from fegear.linalg import inverse_columns, inverse_off_block, requested_backend, resolve_backend
-from fegear.mesh.cache import cached_file
+from fegear.store.cache import cached_file
 
 __all__ = [
     "SurfacePoints",
@@ -250,6 +250,25 @@ def _facet_frames(mesh: skfem.MeshTet, boundary: str) -> _FacetFrames:
         return _FacetFrames(a, e1, e2, g11, g12, g22, g11 * g22 - g12 * g12, tri.mean(axis=1))
 
     return _memo(mesh, "frames:" + boundary, build)
+
+
+def prepare_locators(mesh: skfem.MeshTet, boundaries: Sequence[str] = ()) -> None:
+    """Build now the search structures that locating points on ``mesh`` builds on first use:
+    the facet-to-tetrahedron map ``f2t``, the tetrahedra's affine maps and centroid KD-tree
+    (:func:`find_tets`), and the facet frames and centroid KD-tree of each of ``boundaries``
+    (:func:`locate_on_boundary`).
+
+    For a process about to fork workers that locate cells on the mesh
+    (:func:`fegear.ltca.cycle.run_ltca`): built once here, the children share them
+    copy-on-write instead of each building its own. The structures are the ones the lazy path
+    builds (same inputs, same code), so the located points are identical."""
+    _ = mesh.f2t
+    _tet_affine(mesh)
+    _tree(mesh, "tets", lambda: mesh.p[:, mesh.t].mean(axis=1).T)
+    for b in boundaries:
+        if b in (mesh.boundaries or {}):
+            F = _facet_frames(mesh, b)
+            _tree(mesh, b, lambda F=F: F.centroid)
 
 
 def locate_on_boundary(

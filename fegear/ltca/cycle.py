@@ -83,12 +83,51 @@ def _solve_chunk(r: range, job: dict[str, object] | None = None) -> list[LoadedP
     return out
 
 
+def _prepare(models: MemberModels) -> float:
+    """Build in this process, before the workers fork, what every position reads and would
+    otherwise be built on first use in each worker (:meth:`fegear.ltca.model.MemberModel.prepare`:
+    the mesh and flank point locators, the operator's row and column maps); the workers share
+    them copy-on-write, and later runs on the same models (a torque sweep) reuse them. Returns
+    the seconds taken (part of the models' time: structures of the models, not of a
+    position)."""
+    t0 = time.perf_counter()
+    models.pinion.prepare()
+    models.gear.prepare()
+    return time.perf_counter() - t0
+
+
 def _worker_init(threads: int) -> None:
     """In a forked worker: its share of the cores for the threaded half-space evaluation
-    (row blocks, each computed whole by one thread: the same numbers with any thread count), and
-    one BLAS thread (:func:`_one_blas_thread`)."""
+    (row blocks, each computed whole by one thread: the same numbers with any thread count), one
+    BLAS thread (:func:`_one_blas_thread`), and a heap that keeps its pages
+    (:func:`_keep_heap`)."""
     os.environ["FEGEAR_THREADS"] = str(threads)
     _one_blas_thread()  # for the worker's lifetime (never restored)
+    _keep_heap()
+
+
+#: glibc ``mallopt`` parameters (``malloc.h``): ``M_TRIM_THRESHOLD``, ``M_MMAP_THRESHOLD``.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+
+
+def _keep_heap() -> None:
+    """Let this worker's heap keep the pages it has touched (glibc only; elsewhere a no-op).
+
+    A position allocates and frees many dense arrays of megabytes (compliance blocks, half-space
+    influences, gathers of the operator). By default glibc serves each one above its mmap
+    threshold (128 kB at start, raised only as such blocks are freed) with a fresh ``mmap`` and
+    gives the heap's free top back to the system above twice that, so a new array is faulted in
+    and zeroed by the kernel page by page again, in every worker. With both thresholds raised
+    (64 MB, 256 MB) the freed pages are reused; the worker's peak memory is unchanged (it exits
+    with the pool). Only the worker's process is affected; the arithmetic is the same."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(_M_MMAP_THRESHOLD, 64 << 20)
+        libc.mallopt(_M_TRIM_THRESHOLD, 256 << 20)
+    except (OSError, AttributeError):
+        pass
 
 
 def _one_blas_thread():
@@ -234,7 +273,7 @@ def run_ltca(
             max_cells=opt.max_cells,
             trim=opt.trim,
         )
-    seconds["models"] = models.seconds
+    seconds["models"] = models.seconds + _prepare(models)
     t0 = time.perf_counter()
     # The exact flank evaluators are built on first use (spiral bevel: 0.8 s per flank): once
     # here, not in every forked worker.
@@ -261,7 +300,7 @@ def run_ltca(
             [tuple(int(x) for x in p) for p in grown.pairs],
         )
         models = build_models(pinion, gear, assembly, opt, zone=grown)
-        seconds["models"] += models.seconds
+        seconds["models"] += models.seconds + _prepare(models)
         out = _solve_all({**job, "models": models}, parts, workers, progress)
     seconds["positions"] = time.perf_counter() - t0
     log.info("%d positions in %.2f s (%d workers)", len(out), seconds["positions"], workers)
@@ -278,6 +317,7 @@ def run_ltca(
         phase2=float(asm.phase2),
         zone_gap_mm=float(models.zone.gap_mm) if models.zone is not None else 0.0,
         zone=models.zone,
+        models=models,
     )
 
 

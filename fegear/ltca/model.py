@@ -26,6 +26,7 @@ from fegear.compliance import (
     candidate_operator,
     find_tets,
     load_operator,
+    prepare_locators,
 )
 from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body
@@ -89,6 +90,16 @@ class MemberModel:
         """Member tooth ``tooth`` is in the sector and its flank in the operator."""
         t = tooth + self.sector.centre_tooth
         return 0 <= t < self.sector.n_teeth and (self.teeth is None or t in self.teeth)
+
+    def prepare(self) -> None:
+        """Build the lazily made structures every mesh position reads: the point locators of
+        the mesh and of the working flanks in the operator
+        (:func:`fegear.compliance.prepare_locators`) and the operator's row and column maps.
+        Called by a process before it forks the workers that solve the positions (each would
+        otherwise build its own); the positions' numbers do not change."""
+        teeth = range(self.sector.n_teeth) if self.teeth is None else self.teeth
+        prepare_locators(self.body.mesh, [f"flank_{self.side}_{t}" for t in teeth])
+        _ = self.op._row_map, self.op._col_maps
 
 
 def build_member_model(
@@ -173,7 +184,7 @@ def _facet_dofs(basis, facets: np.ndarray) -> np.ndarray:
 
 def _cached_layer_tets(mesh, facets: np.ndarray, depth: float, key: dict) -> np.ndarray:
     """:func:`_layer_tets`, read from the cache when the same mesh was layered before (0.2 s)."""
-    from fegear.mesh.cache import cached_file
+    from fegear.store.cache import cached_file
 
     def build(path) -> None:
         with open(path, "wb") as fh:
