@@ -28,8 +28,9 @@ import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 
@@ -39,20 +40,36 @@ from fegear.ltca.analysis import (
     MemberModels,
     build_models,
     cycle_zone,
-    solve_position,
 )
+from fegear.ltca.fidelity import fidelity_of
 from fegear.ltca.results import LoadedCycle, LoadedPosition
 from fegear.ltca.zone import ContactZone
-from fegear.tca import TCAOptions
+from fegear.tca import TCA, TCAOptions
 from fegear.tca.cached import cached_tca
+from fegear.tca.results import PositionResult
 
 __all__ = ["run_ltca", "chunks", "cycle_tca", "grown_zone"]
 
 log = logging.getLogger(__name__)
 
+
+@dataclass(frozen=True)
+class CycleJob:
+    """What the workers solving the positions share: the TCA and its positions, the models,
+    the options and the torque; ``done`` takes the index of each finished position (a queue to
+    the parent, or the progress callback in one process)."""
+
+    tca: TCA
+    positions: tuple[PositionResult, ...]
+    models: MemberModels
+    options: LTCAOptions
+    torque2_Nmm: float
+    done: Any = None
+
+
 # The job of the forked workers: set in the parent just before the pool forks (the children
 # inherit it; nothing is pickled but the chunk bounds and the results).
-_JOB: dict[str, object] = {}
+_JOB: list[CycleJob] = []
 
 
 def chunks(n: int, size: int) -> list[range]:
@@ -64,22 +81,19 @@ def chunks(n: int, size: int) -> list[range]:
     return [range(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
 
 
-def _solve_chunk(r: range, job: dict[str, object] | None = None) -> list[LoadedPosition]:
-    """Solve the positions ``r`` in sequence, each from its predecessor."""
-    j = _JOB if job is None else job
-    tca, tca_pos, models, opt = j["tca"], j["positions"], j["models"], j["options"]
-    torque, done = j["torque"], j["done"]
+def _solve_chunk(r: range, job: CycleJob | None = None) -> list[LoadedPosition]:
+    """Solve the positions ``r`` in sequence, each from its predecessor, with the job's
+    fidelity (:meth:`fegear.ltca.fidelity.Fidelity.solve_position`)."""
+    j = _JOB[0] if job is None else job
+    fid = fidelity_of(j.options.fidelity)
     out: list[LoadedPosition] = []
     for i in r:
-        pos = tca_pos[i]
-        if opt.fidelity == "hertz":
-            from fegear.ltca.hertz_model import solve_position_hertz
-
-            res = solve_position_hertz(tca, pos, models, torque, opt.E_MPa, opt.nu)
-        else:
-            res = solve_position(tca, pos, models, torque, opt.g_max_mm, out[-1] if out else None)
+        previous = out[-1] if out else None
+        res = fid.solve_position(
+            j.tca, j.positions[i], j.models, j.torque2_Nmm, j.options, previous
+        )
         out.append(res)
-        done.put(i)
+        j.done.put(i)
     return out
 
 
@@ -169,17 +183,16 @@ def _workers(requested: int | None, n_chunks: int) -> int:
     return want
 
 
-def _solve_all(job: dict[str, object], parts: list[range], workers: int, progress) -> list:
+def _solve_all(job: CycleJob, parts: list[range], workers: int, progress) -> list:
     n = sum(len(r) for r in parts)
     if workers == 1:
         finished = itertools.count(1)
         done = SimpleNamespace(put=lambda _i: progress and progress(next(finished), n))
         with _one_blas_thread():
-            return [p for r in parts for p in _solve_chunk(r, {**job, "done": done})]
+            return [p for r in parts for p in _solve_chunk(r, replace(job, done=done))]
     ctx = multiprocessing.get_context("fork")
     done = ctx.SimpleQueue()
-    _JOB.clear()
-    _JOB.update(job, done=done)
+    _JOB[:] = [replace(job, done=done)]
     try:
         threads = max(1, (os.cpu_count() or 1) // workers)
         with ProcessPoolExecutor(
@@ -281,13 +294,7 @@ def run_ltca(
     tca.fm2.native_box()
     parts = chunks(len(tca_pos), opt.chunk_positions)
     workers = _workers(opt.workers, len(parts))
-    job = {
-        "tca": tca,
-        "positions": tca_pos,
-        "models": models,
-        "options": opt,
-        "torque": float(torque2_Nmm),
-    }
+    job = CycleJob(tca, tuple(tca_pos), models, opt, float(torque2_Nmm))
     out = _solve_all(job, parts, workers, progress)
     for _ in range(3):
         grown = grown_zone(pinion, gear, assembly, opt, models, out, tca_pos)
@@ -301,7 +308,7 @@ def run_ltca(
         )
         models = build_models(pinion, gear, assembly, opt, zone=grown)
         seconds["models"] += models.seconds + _prepare(models)
-        out = _solve_all({**job, "models": models}, parts, workers, progress)
+        out = _solve_all(replace(job, models=models), parts, workers, progress)
     seconds["positions"] = time.perf_counter() - t0
     log.info("%d positions in %.2f s (%d workers)", len(out), seconds["positions"], workers)
     return LoadedCycle(
