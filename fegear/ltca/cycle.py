@@ -97,6 +97,30 @@ def _solve_chunk(r: range, job: CycleJob | None = None) -> list[LoadedPosition]:
     return out
 
 
+def _prime_flank_maps(tca: TCA) -> None:
+    """Evaluate both exact flank maps of ``tca`` once, at the middle of their working flanks
+    (native parameters, point, and back to flank coordinates), their native bounds, and the
+    TCA's start values of the Newton solves on the gear flank (:meth:`fegear.tca.TCA.gear_start`,
+    an interpolator made on first use).
+
+    What a map builds on first use is then built once, in this process, before the workers
+    fork, instead of once in every worker (they share it copy-on-write): the native bounds (a
+    Newton inversion for the spiral bevel), and what a member computes lazily to evaluate its
+    flank, e.g. the face gear's fillet-limit tables
+    (:meth:`fegear.geometry.face_gear.FaceGearMember.height` and ``working_u``), which the TCA
+    read from the cache does not carry. A lazily built value is the same wherever it is built:
+    the positions' numbers do not change. Timed apart from the positions (``seconds["flanks"]``
+    of the cycle): a cost per run, not per position."""
+    for fm in (tca.fm1, tca.fm2):
+        fm.native_box()
+        bd = fm.bounds
+        u = np.array([0.5 * (bd.u_fillet + bd.u_tip)])
+        v = np.array([0.5 * (bd.v_start + bd.v_end)])
+        a, b, p, _ = fm.native_point(u, v)
+        fm.flank(a, b, p)
+    tca.gear_start(*tca.gtree.data[:1].T)
+
+
 def _prepare(models: MemberModels) -> float:
     """Build in this process, before the workers fork, what every position reads and would
     otherwise be built on first use in each worker (:meth:`fegear.ltca.model.MemberModel.prepare`:
@@ -288,10 +312,9 @@ def run_ltca(
         )
     seconds["models"] = models.seconds + _prepare(models)
     t0 = time.perf_counter()
-    # The exact flank evaluators are built on first use (spiral bevel: 0.8 s per flank): once
-    # here, not in every forked worker.
-    tca.fm1.native_box()
-    tca.fm2.native_box()
+    _prime_flank_maps(tca)
+    seconds["flanks"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
     parts = chunks(len(tca_pos), opt.chunk_positions)
     workers = _workers(opt.workers, len(parts))
     job = CycleJob(tca, tuple(tca_pos), models, opt, float(torque2_Nmm))
