@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -45,7 +46,7 @@ CHILD = r"""
 import json, resource, sys, time
 import numpy as np
 from fegear.case import load_case
-from fegear.io.gear_case import build_pair
+from fegear.pipeline.pair import build_pair
 from fegear.ltca import LTCAOptions, run_ltca
 path, fid, lv, npos = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
 case = load_case(path)
@@ -73,18 +74,39 @@ print(json.dumps({
 """
 
 
+def _busy_cpu_s() -> float:
+    """CPU seconds all processes of the machine have used since boot (``/proc/stat``: user, nice,
+    system, irq, softirq, steal); NaN where there is no ``/proc/stat``."""
+    try:
+        with open("/proc/stat") as fh:
+            f = [int(x) for x in fh.readline().split()[1:9]]
+    except OSError:
+        return float("nan")
+    return (f[0] + f[1] + f[2] + f[5] + f[6] + f[7]) / os.sysconf("SC_CLK_TCK")
+
+
+def _children_cpu_s() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def _child(path: Path, fid: str, level: int, npos: int, cache: str) -> dict:
+    """One run in a fresh process, with ``others_cpu_s``: the CPU seconds the rest of the machine
+    used meanwhile (all processes' CPU over the run minus the child's and its workers'); ~0 on
+    an idle machine, the load average before a run says nothing of what starts during it."""
     env = dict(os.environ, FEGEAR_CACHE=cache)
+    busy, mine = _busy_cpu_s(), _children_cpu_s()
     res = subprocess.run(
         [sys.executable, "-c", CHILD, str(path), fid, str(level), str(npos)],
         env=env,
         capture_output=True,
         text=True,
     )
+    others = (_busy_cpu_s() - busy) - (_children_cpu_s() - mine)
     if res.returncode != 0:
         tail = res.stderr.strip().splitlines()[-1] if res.stderr.strip() else "?"
         return {"fidelity": fid, "level": level, "failed": tail}
-    return json.loads(res.stdout.strip().splitlines()[-1])
+    return {**json.loads(res.stdout.strip().splitlines()[-1]), "others_cpu_s": others}
 
 
 def run(scene: str, fid: str, level: int) -> dict:
@@ -104,6 +126,7 @@ def run(scene: str, fid: str, level: int) -> dict:
     out["warm_s"] = warm.get("seconds", float("nan"))
     out["warm_stages"] = warm.get("stages", {})
     out["load_avg"] = [load_cold, load_warm]
+    out["others_cpu_s"] = [cold["others_cpu_s"], warm.get("others_cpu_s", float("nan"))]
     out["rss_MB"] = max(cold["rss_MB"], warm.get("rss_MB", 0.0))
     return out
 
@@ -156,7 +179,9 @@ def table(scene: str, runs: list[dict]) -> str:
         f"`python benchmarks/bench_fidelity.py {scene} ...` (2 cores; times exclude the "
         "tooth-surface generation; warm positions = the warm run's time solving the positions "
         "(the rest is reading the cached operators and TCA); load avg = the machine's 1-minute "
-        "load average before the cold / warm run (— not recorded); "
+        "load average before the cold / warm run (— not recorded; before the warm run it still "
+        "holds the cold run's own load); others = the CPU seconds the other processes of the "
+        "machine used during the cold / warm run; "
         "p_max int. = over the positions where neither run has an "
         "edge contact; p_peak = the recovered peak of :func:`fegear.patch.measure_patch`, "
         "p_max = the largest cell pressure)",
@@ -182,10 +207,12 @@ def table(scene: str, runs: list[dict]) -> str:
         a = "reference" if key == ("fe", ref_fe["level"]) else err(r)
         pos = r.get("warm_stages", {}).get("positions")
         load = r.get("load_avg")
+        others = r.get("others_cpu_s")
         row = (
             f"| {r['fidelity']} | {r['level']} | {r['cold_s']:.1f} | {r['warm_s']:.1f} | "
             f"{'—' if pos is None else f'{pos:.1f}'} | "
-            f"{'—' if load is None else ' / '.join(f'{x:.2f}' for x in load)} | "
+            f"{'—' if load is None else ' / '.join(f'{x:.2f}' for x in load)}"
+            f"{'' if others is None else '; others ' + ' / '.join(f'{x:.1f}' for x in others)} | "
             f"{r['rss_MB']:.0f} | {r['te_pp']:.3f} | {r['te_mean']:.3f} | "
             f"{r['contact_ratio']:.2f} | {r['p_max_interior']:.0f} / {r['p_peak_interior']:.0f} | "
             f"{a} |"
@@ -197,6 +224,9 @@ def table(scene: str, runs: list[dict]) -> str:
 
 
 def main() -> None:
+    if len(sys.argv) < 2 or sys.argv[1] not in SCENES:
+        print(__doc__)
+        sys.exit(0 if sys.argv[1:2] in (["-h"], ["--help"]) else 2)
     scene = sys.argv[1]
     specs = [(a.split(":")[0], int(a.split(":")[1])) for a in sys.argv[2:]]  # none: table only
     out_json = HERE / "results" / f"fidelity_{scene}.json"
