@@ -743,10 +743,13 @@ def run(
     InputError
         A bad override, design data the geometry refuses, or an installation under which the
         flanks cannot mesh (no contact anywhere, a tip running into the mate's root), each named
-        and decided before the FE work.
+        and decided before the FE work; an unusable cache folder (``FEGEAR_CACHE``).
     FegearError
         The analysis failed (mesh, solver).
     """
+    from fegear.store.cache import check_cache_root
+
+    check_cache_root()
     if isinstance(case, HertzCase):
         if root_stress:
             raise InputError("root_stress", root_stress, "absent for the Hertz scene (no teeth)")

@@ -122,10 +122,15 @@ def _parser() -> argparse.ArgumentParser:
         "cache",
         help="the mesh/operator cache: where it is and what it holds, or clear it",
         description="The artefact cache (sector meshes, compliance operators, TCA) is in the "
-        "per-user cache folder of the platform, or in $FEGEAR_CACHE if set.",
+        "per-user cache folder of the platform, or in $FEGEAR_CACHE if set. It keeps itself "
+        "within a size cap ($FEGEAR_CACHE_LIMIT, default 10GB; 'none' for no cap) by evicting "
+        "its least recently used entries, and verifies every entry it reads (size and "
+        "checksum), rebuilding a damaged one.",
     )
     csub = c.add_subparsers(dest="cache_command", required=True)
-    csub.add_parser("info", help="where the cache is, its size per kind and number of files")
+    csub.add_parser(
+        "info", help="where the cache is, its size per kind, its entries and its size cap"
+    )
     cc = csub.add_parser("clear", help="delete the cached artefacts (all, or one kind)")
     cc.add_argument("--kind", help="only this kind (a folder name shown by `fegear cache info`)")
     pl = sub.add_parser(
@@ -376,8 +381,16 @@ def _cache(args: argparse.Namespace) -> int:
         print("  warning: this folder is not a fegear cache (no fegear CACHEDIR.TAG)")
     width = max([len(k.kind) for k in info.kinds] + [5])
     for k in info.kinds:
-        print(f"  {k.kind:<{width}}  {k.files:6d} files  {_size(k.bytes):>10}")
-    print(f"  {'total':<{width}}  {info.files:6d} files  {_size(info.bytes):>10}")
+        print(f"  {k.kind:<{width}}  {k.entries:5d} entries  {k.files:6d} files  "
+              f"{_size(k.bytes):>10}")  # fmt: skip
+    print(f"  {'total':<{width}}  {info.entries:5d} entries  {info.files:6d} files  "
+          f"{_size(info.bytes):>10}")  # fmt: skip
+    cap = "none" if info.limit == float("inf") else _size(int(info.limit))
+    share = "" if info.limit == float("inf") else f" ({100 * info.bytes / info.limit:.0f} % used)"
+    print(
+        f"  size cap {cap}{share}: the least recently used entries are evicted beyond it "
+        "(FEGEAR_CACHE_LIMIT, e.g. 20GB or none)"
+    )
     legacy = Path.cwd() / "meshes" / "cache"
     if legacy.is_dir() and legacy.resolve() != info.root.resolve():
         print(
@@ -494,6 +507,10 @@ def main(argv: list[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        if args.command in ("run", "sweep"):
+            from fegear.store.cache import check_cache_root
+
+            check_cache_root()  # an unusable FEGEAR_CACHE is refused before any work
         if args.command == "run":
             return _run(args)
         if args.command == "sweep":

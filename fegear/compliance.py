@@ -36,7 +36,7 @@ from __future__ import annotations
 import logging
 import time
 import weakref
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -475,9 +475,9 @@ def candidate_operator(
     """``(K^{-1})_{cf}`` on the candidate DOFs ``c = dofs`` and the load DOFs ``f = load_dofs``
     (full numbering; default all of ``dofs``; clamped ones dropped from both; ``f ⊂ c``).
 
-    With ``cache_key`` (a mapping describing the mesh, material and boundary conditions), the
-    block is read from / written to the on-disk cache; the candidate and load DOFs are part of the
-    key.
+    With ``cache_key`` (a mapping describing the mesh and the boundary conditions), the blocks
+    are read from / written to the on-disk cache (:mod:`fegear.store.cache`), each an entry of
+    its own keyed on the body, the material and the DOFs it holds.
 
     ``groups`` (``[(load_g, read_g), ...]``, e.g. one per loaded tooth: its flank DOFs and the
     DOFs of the layer below them) says which read-only rows are ever read under which loads: then
@@ -490,8 +490,10 @@ def candidate_operator(
     tooth read under the load of another) are never computed (NaN in
     :meth:`CandidateOperator.take`). Measured on the seed face gear's level-0 sector (3 loaded
     teeth, f = 6246, l = 10 902): 31.7 s against 127.9 s for the whole block (2 cores, with
-    another process running). Stored as the blocks, one after the other in one file
-    (:func:`_write_blocks`), not as a ``(m, k)`` array mostly NaN: 498 MB instead of 857 MB there.
+    another process running). ``G_ff`` is the same cache entry as the square operator on ``f``
+    alone (what the ``fe`` and ``hertz`` fidelities read), and each group's block is an entry of
+    its own (``(K⁻¹)_{read_g, load_g}`` depends on ``K`` alone), so the fidelities share what
+    they have in common and only a missing block is ever computed.
     """
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     f = c if load_dofs is None else np.intersect1d(np.asarray(load_dofs, np.int64), body.free)
@@ -509,67 +511,58 @@ def candidate_operator(
     requested_backend(backend)  # a bad name is refused on a cache hit too
     used = ""
 
-    def compute() -> Iterator[np.ndarray]:
-        """The blocks of ``layout``, in order."""
+    def solver() -> str:
         nonlocal used
-        used = resolve_backend(backend)  # only when computing: loading MKL takes 0.3 s
-        if groups_ is None:
-            yield inverse_columns(body.K, pos, np.isin(c, f), backend=used)
-            return
-        G_ff = inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=used)
-        yield G_ff
-        for (fg, lg), (_, cols_g) in zip(groups_, layout[1:], strict=True):
-            cg = np.union1d(fg, lg)
-            yield inverse_off_block(
-                body.K,
-                np.searchsorted(body.free, cg),
-                np.isin(cg, fg),
-                G_ff[np.ix_(cols_g, cols_g)],
-                used,
-            )
+        used = used or resolve_backend(backend)  # only when computing: loading MKL takes 0.3 s
+        return used
 
-    if cache_key is None:
-        arrays = list(compute())
-        hit = False
-    else:
-        params = {
-            "kind": "inverse_block_v1",
-            "body": cache_key,
-            "dofs": c,
-            "E": body.E,
-            "nu": body.nu,
-            "n_free": int(body.free.size),
-        }
+    base = {"body": cache_key, "E": body.E, "nu": body.nu, "n_free": int(body.free.size)}
+    if groups_ is None:
+        params = {"kind": "inverse_block_v1", **base, "dofs": c}
         if f.size < c.size:
             params.update(kind="inverse_columns_v1", cols=f)
-        if groups_ is not None:
-            # v2: the blocks one after the other (v1 held the whole (m, k) array)
-            params.update(kind="inverse_group_blocks_v2", groups=[g for b in groups_ for g in b])
+        G, hit = _cached_block(
+            params,
+            cache_key is not None,
+            lambda: inverse_columns(body.K, pos, np.isin(c, f), backend=solver()),
+        )
+        arrays, hits = [G], [hit]
+    else:
+        # G_ff is the entry a square operator on f alone is (the ``fe`` fidelity's): every
+        # fidelity on the same flanks shares it; each group's block is an entry of its own, so
+        # that a block missing from the cache is the only one computed
+        G_ff, hit = _cached_block(
+            {"kind": "inverse_block_v1", **base, "dofs": f},
+            cache_key is not None,
+            lambda: inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=solver()),
+        )
+        arrays, hits = [G_ff], [hit]
+        for (fg, lg), (_, cols_g) in zip(groups_, layout[1:], strict=True):
+            cg = np.union1d(fg, lg)
 
-        def build(path: Path) -> None:
-            if groups_ is None:
-                with open(path, "wb") as fh:
-                    np.save(fh, next(compute()))
-            else:
-                _write_blocks(path, [(r.size, k.size) for r, k in layout], compute())
+            def off(cg=cg, fg=fg, cols_g=cols_g) -> np.ndarray:
+                return inverse_off_block(
+                    body.K,
+                    np.searchsorted(body.free, cg),
+                    np.isin(cg, fg),
+                    G_ff[np.ix_(cols_g, cols_g)],
+                    solver(),
+                )
 
-        path, hit = cached_file("compliance", params, ".npy", build)
-        # Memory-mapped: a position reads only the rows and columns its cells touch.
-        stored = np.load(path, mmap_mode="r")
-        if groups_ is None:
-            arrays = [stored]
-        else:
-            arrays, at = [], 0
-            for r, k in layout:
-                arrays.append(stored[at : at + r.size * k.size].reshape(r.size, k.size))
-                at += r.size * k.size
+            params = {"kind": "inverse_off_block_v1", **base, "load": fg, "read": lg}
+            B, hit = _cached_block(params, cache_key is not None, off)
+            arrays.append(B)
+            hits.append(hit)
+    hit = all(hits)
     dt = time.perf_counter() - t0
     log.info(
-        "candidate operator: %d DOFs, %d load DOFs in %.2f s (%s)",
+        "candidate operator: %d DOFs, %d load DOFs in %.2f s (%d of %d blocks from the cache%s)",
         c.size,
         f.size,
         dt,
-        "cache" if hit else used,
+        sum(hits),
+        len(hits),
+        "" if hit else f", {used}",
     )
     fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
     blocks = tuple(OperatorBlock(r, k, G) for (r, k), G in zip(layout, arrays, strict=True))
@@ -584,19 +577,21 @@ def candidate_operator(
     )
 
 
-def _write_blocks(path: Path, shapes: list[tuple[int, int]], blocks: Iterator[np.ndarray]) -> None:
-    """Write the blocks of ``shapes`` (each ``(r, k)`` float64, as ``blocks`` yields them, one in
-    memory at a time) one after the other, row-major, as one 1-D ``.npy`` array (memory-mapped
-    back by :func:`candidate_operator`)."""
-    total = sum(r * k for r, k in shapes)
-    header = {"descr": np.lib.format.dtype_to_descr(np.dtype(np.float64)),
-              "fortran_order": False, "shape": (total,)}  # fmt: skip
-    with open(path, "wb") as fh:
-        np.lib.format.write_array_header_1_0(fh, header)
-        for (r, k), G in zip(shapes, blocks, strict=True):
-            if G.shape != (r, k):
-                raise SolverError(f"operator block of shape {G.shape}, expected {(r, k)}")
-            fh.write(memoryview(np.ascontiguousarray(G, dtype=np.float64)).cast("B"))
+def _cached_block(
+    params: dict, cached: bool, compute: Callable[[], np.ndarray]
+) -> tuple[np.ndarray, bool]:
+    """``(block, hit)``: one dense operator block, from the ``compliance`` cache entry of
+    ``params`` (memory-mapped: a position reads only the rows and columns its cells touch) or
+    computed by ``compute()`` (and written there when ``cached``)."""
+    if not cached:
+        return compute(), False
+
+    def build(path: Path) -> None:
+        with open(path, "wb") as fh:
+            np.save(fh, compute())
+
+    path, hit = cached_file("compliance", params, ".npy", build)
+    return np.load(path, mmap_mode="r"), hit
 
 
 def _groups(c, f, free, groups) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -131,14 +131,20 @@ def test_cache_info_and_clear(monkeypatch, tmp_path, capsys):
     _fill("beta", 2)
     info = fcache.cache_info()
     assert info.is_cache and info.source == "FEGEAR_CACHE"
-    assert [(k.kind, k.files, k.bytes) for k in info.kinds] == [("alpha", 3, 6), ("beta", 2, 3)]
+    # an entry is its data file and its record (sizes and checksums)
+    on_disk = {k: sum(p.stat().st_size for p in (root / k).iterdir()) for k in ("alpha", "beta")}
+    assert [(k.kind, k.entries, k.files, k.bytes) for k in info.kinds] == [
+        ("alpha", 3, 6, on_disk["alpha"]),
+        ("beta", 2, 4, on_disk["beta"]),
+    ]
     assert main(["cache", "info"]) == 0
     out = capsys.readouterr().out
     assert str(root) in out and "FEGEAR_CACHE" in out
-    assert any(ln.split()[:3] == ["alpha", "3", "files"] for ln in out.splitlines())
-    assert any(ln.split()[:3] == ["total", "5", "files"] for ln in out.splitlines())
+    assert any(ln.split()[:3] == ["alpha", "3", "entries"] for ln in out.splitlines())
+    assert any(ln.split()[:5] == ["total", "5", "entries", "10", "files"] for ln in out.splitlines())
+    assert "size cap 10.0 GB" in out  # the default cap, shown
     assert main(["cache", "clear", "--kind", "alpha"]) == 0
-    assert "removed 3 files" in capsys.readouterr().out
+    assert "removed 6 files" in capsys.readouterr().out
     assert [k.kind for k in fcache.cache_info().kinds] == ["beta"]
     assert main(["cache", "clear", "--kind", "gamma"]) == 2  # not a kind of the cache
     assert "--kind" in capsys.readouterr().err

@@ -208,17 +208,30 @@ def cycle_zone(
 def build_models(
     pinion, gear, assembly, options: LTCAOptions, zone: ContactZone | None = None
 ) -> MemberModels:
-    """Mesh both sectors, fine in the contact ``zone`` (default :func:`cycle_zone`), and
-    compute their compliance operators (cached)."""
+    """Mesh both sectors of ``zone.n_teeth`` teeth (default :func:`cycle_zone`), fine on the
+    whole working flank of every tooth that can carry load (all but the outer tooth at each
+    end), and compute their compliance operators (cached).
+
+    What the models depend on is the member's design, the tooth count, the mesh level, the
+    working side and the material: not the installation errors, the torque, the positions or
+    the fidelity (the TCA's zone only sets the tooth count), so a study over any of those reads
+    them from the cache (``docs/ltca/studies.md``). The operator of each member is the flank
+    block ``(K⁻¹)_ff`` of those teeth, shared by every fidelity, plus, for ``hybrid``, one
+    block per tooth for the layer below its flank (:func:`~fegear.ltca.model.build_member_model`),
+    each a cache entry of its own."""
     t0 = time.perf_counter()
     if zone is None:
         zone = cycle_zone(pinion, gear, assembly, options)
-    jobs = [(pinion, zone.pinion or None), (gear, zone.gear or None)]
-    sectors = [sector_mesh(m, zone.n_teeth, options.level, zone=z) for m, z in jobs]
+    n = zone.n_teeth
+    sides = (assembly.side1, assembly.side2)
+    sectors = [
+        sector_mesh(m, n, options.level, side=side)
+        for m, side in zip((pinion, gear), sides, strict=True)
+    ]
     h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
     module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
-    depth = layer = 0.0
     depth = layer = fidelity_of(options.fidelity).layer_depth(h, module, options)
+    loaded = tuple(range(1, n - 1)) if n >= 3 else tuple(range(n))
     models = [
         build_member_model(
             member.name,
@@ -228,12 +241,9 @@ def build_models(
             options.nu,
             options.backend,
             layer_mm=layer,
-            teeth=tuple(sorted({q.tooth for q in z})) or None,
+            teeth=loaded,
         )
-        for member, side, sm, z in (
-            (pinion, assembly.side1, sectors[0], zone.pinion),
-            (gear, assembly.side2, sectors[1], zone.gear),
-        )
+        for member, side, sm in zip((pinion, gear), sides, sectors, strict=True)
     ]
     cell = options.cell_mm if options.cell_mm is not None else h
     return MemberModels(

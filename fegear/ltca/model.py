@@ -113,9 +113,13 @@ def build_member_model(
     teeth: tuple[int, ...] | None = None,
 ) -> MemberModel:
     """Assemble a sector and compute ``(K⁻¹)_cc`` on the working-flank DOFs of the sector
-    teeth ``teeth`` (None: all; the teeth that can touch, :mod:`fegear.ltca.zone`: the dense
-    operator costs the cube of its size) and, with ``layer_mm > 0``, on the DOFs of the
-    tetrahedra down to that depth below them."""
+    teeth ``teeth`` (None: all; the teeth that can carry load, :func:`fegear.ltca.build_models`:
+    the dense operator costs the cube of its size) and, with ``layer_mm > 0``, on the DOFs of
+    the tetrahedra down to that depth below them.
+
+    The operator is cached as blocks (:func:`fegear.compliance.candidate_operator`): the flank
+    block ``(K⁻¹)_ff`` of all those teeth (every fidelity reads it), and with a layer one block
+    ``(K⁻¹)_{l_t f_t}`` per tooth ``t`` (or one for all teeth where their layers meet)."""
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
     clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
@@ -127,12 +131,12 @@ def build_member_model(
     per_tooth = [np.sort(mesh.boundaries[f]) for f in flanks]
     facets = np.concatenate(per_tooth)
     dofs = _facet_dofs(body.basis, facets)
+    # what the operator blocks depend on besides their DOFs: the mesh and its clamped faces (the
+    # material and the DOFs join in fegear.compliance); not the layer depth or the fidelity, so
+    # that every fidelity reads the same flank block
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
         "clamped": clamped,
-        "flanks": flanks,
-        "facets": facets,
-        "layer_mm": layer_mm,
     }
     flank_dofs = dofs  # the cells load only these; the layer is only read
     layer_tets = np.zeros(mesh.t.shape[1], dtype=bool)
@@ -141,16 +145,16 @@ def build_member_model(
         # the layer under each tooth is read only under the loads of that tooth's own cells
         # (the hybrid's matching points; other pairs are read at the surface): one block each
         groups = []
-        for i, fac in enumerate(per_tooth):
-            tets = _cached_layer_tets(mesh, fac, layer_mm, {**key, "tooth": i})
+        for f, fac in zip(flanks, per_tooth, strict=True):
+            tets = _cached_layer_tets(mesh, fac, layer_mm, {**key, "flank": f, "depth": layer_mm})
             layer_tets[tets] = True
             fd = _facet_dofs(body.basis, fac)
             groups.append((fd, np.setdiff1d(body.basis.element_dofs[:, tets].ravel(), flank_dofs)))
         dofs = np.union1d(dofs, body.basis.element_dofs[:, layer_tets].ravel())
         reads = np.concatenate([g[1] for g in groups])
         if np.unique(reads).size != reads.size:  # layers of two teeth meet: one block
-            log.info("%s: the layers below the loaded teeth meet; one operator block", name)
-            groups = None
+            log.info("%s: the layers below the loaded teeth meet; one layer block", name)
+            groups = [(flank_dofs, np.setdiff1d(dofs, flank_dofs))]
     op = candidate_operator(
         body, dofs, backend=backend, cache_key=key, load_dofs=flank_dofs, groups=groups
     )

@@ -610,6 +610,7 @@ def sector_mesh(
     algorithm: int = 10,
     min_sicn: float = 0.03,
     fillet_mm: float | None = None,
+    side: Side = "drive",
 ) -> SectorMesh:
     """Mesh (or load from the cache) a sector of ``n_teeth`` teeth of ``member``.
 
@@ -622,8 +623,10 @@ def sector_mesh(
     level
         Size knob 0 (coarse) … 4 (fine), see :data:`FINE`, :data:`COARSE`.
     zone
-        Potential contact zone as flank boxes; default :func:`default_zone` (whole drive flank
-        of the centre teeth). Fillets of the zone teeth are refined too.
+        Potential contact zone as flank boxes; default :func:`default_zone` (the whole working
+        ``side`` flank of the centre teeth: what the loaded analysis meshes, so that a sector
+        depends only on the member, the tooth count, the level and the side, never on where the
+        mate sits). Fillets of the zone teeth are refined too.
     rim_modules
         Rim thickness below the root in modules (involute, spiral bevel).
     algorithm
@@ -636,6 +639,8 @@ def sector_mesh(
         ``diagnostics["fillet_mm"]``); None: ``1.25 h_fine``. The root
         stress is read there (:mod:`fegear.fem.stress`; its convergence under this size:
         ``benchmarks/results/root_stress_refinement.md``).
+    side
+        Working flank side of the default zone (``"drive"`` or ``"coast"``).
 
     Raises
     ------
@@ -646,7 +651,7 @@ def sector_mesh(
         raise InputError("mesh.n_teeth", n_teeth, f"an integer in 1..{member.n_teeth // 2}")
     mesh_sizes(1.0, level)
     fr = sector_frame(member, rim_modules)
-    zone = tuple(default_zone(fr, n_teeth) if zone is None else zone)
+    zone = tuple(default_zone(fr, n_teeth, side) if zone is None else zone)
     for z in zone:
         if not 0 <= z.tooth < n_teeth:
             raise InputError("mesh.zone.tooth", z.tooth, f"in 0..{n_teeth - 1}")

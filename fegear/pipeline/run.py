@@ -426,24 +426,32 @@ def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
     return {k: np.vstack(v) for k, v in out.items()}
 
 
-def stress_sector(member, model, zone, fillet_mm: float):
-    """The contact sector of ``model`` remeshed with the fillets of its zone teeth at
-    ``fillet_mm`` (:func:`fegear.mesh.sector.sector_mesh`, cached), as a
+def stress_sector(member, model, teeth: tuple[int, ...] | None, fillet_mm: float):
+    """The contact sector of ``model`` remeshed with the fillets of its sector teeth ``teeth``
+    (None: every tooth whose flank the contact sector refines) at ``fillet_mm``
+    (:func:`fegear.mesh.sector.sector_mesh`, cached), as a
     :class:`~fegear.ltca.model.MemberModel` without compliance operator (``op`` None): what
     :func:`fegear.ltca.model.member_load_operator` needs to load it."""
     from dataclasses import replace
 
     from fegear.fem.elasticity import assemble_body
-    from fegear.mesh.sector import sector_mesh
+    from fegear.mesh.sector import default_zone, sector_mesh
+    from fegear.mesh.sector_geometry import sector_frame
 
     p = model.sector.parameters
+    n, rim = int(p["n_teeth"]), float(p.get("rim_modules", 3.0))
+    zone = None
+    if teeth is not None:
+        whole = default_zone(sector_frame(member, rim), n, model.side)
+        zone = tuple(z for z in whole if z.tooth in teeth) or None
     sector = sector_mesh(
         member,
-        int(p["n_teeth"]),
+        n,
         int(p["level"]),
-        zone=zone or None,
-        rim_modules=float(p.get("rim_modules", 3.0)),
+        zone=zone,
+        rim_modules=rim,
         fillet_mm=fillet_mm,
+        side=model.side,
     )
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
@@ -466,7 +474,7 @@ def displacements(
 ) -> tuple[MemberField, ...]:
     """Displacement and stress of both stress sectors at every position: ``u = K⁻¹ P F``.
 
-    The sectors are those of the contact solve remeshed with the fillets of the zone teeth at
+    The sectors are those of the contact solve remeshed with the fillets of the loaded teeth at
     ``fillet_modules`` modules (default :data:`fegear.fem.stress.FILLET_MODULES`,
     :func:`stress_sector`). ``P`` is built exactly as in the contact solve
     (:func:`fegear.ltca.model.member_load_operator`: pinion cells along ``−n1`` at the pinion
@@ -478,8 +486,9 @@ def displacements(
     every tooth that can touch (:func:`fegear.fem.stress.tooth_root_stress`) and the
     equilibrium of the solve (:func:`fegear.fem.stress.reactions`).
 
-    ``refine_teeth``: ``{member: sector teeth}`` whose zone (and fillets) the stress sector
-    refines (default: all the zone teeth; a refinement study refines the tooth it reads only);
+    ``refine_teeth``: ``{member: sector teeth}`` whose flank (and fillets) the stress sector
+    refines (default: every tooth that can carry load; a refinement study refines the tooth it
+    reads only);
     ``keep_dofs``: keep the P2 displacement and the body in the :class:`MemberField`.
     ``root_stress`` False: the displacement on the contact sectors themselves (no remeshing, the
     factorisation of a sector of the contact model's size), without stresses (the contact
@@ -502,18 +511,15 @@ def displacements(
     out = []
     n_pos = len(cycle.positions)
     fm = FILLET_MODULES if fillet_modules is None else float(fillet_modules)
-    zone = models.zone
     for name, model, member in (
         ("pinion", models.pinion, run_pair.pinion),
         ("gear", models.gear, run_pair.gear),
     ):
         p = model.sector.parameters
         module = float(p["h_fine_mm"]) / FINE[int(p["level"])]
-        boxes = None if zone is None else (zone.pinion if name == "pinion" else zone.gear)
-        if refine_teeth is not None and name in refine_teeth and boxes:
-            boxes = tuple(z for z in boxes if z.tooth in refine_teeth[name])
+        teeth = refine_teeth.get(name) if refine_teeth is not None else None
         t0 = time.perf_counter()
-        smodel = stress_sector(member, model, boxes, fm * module) if root_stress else model
+        smodel = stress_sector(member, model, teeth, fm * module) if root_stress else model
         body = smodel.body
         nodal = body.scalar_basis.nodal_dofs[0]  # scalar DOF of each vertex
         vdofs = 3 * nodal[:, None] + np.arange(3)[None, :]

@@ -47,6 +47,7 @@ import hashlib
 import importlib.metadata
 import json
 import logging
+import math
 import os
 import re
 import shutil
@@ -59,7 +60,9 @@ from types import MappingProxyType
 import numpy as np
 
 from fegear.errors import InputError
+from fegear.store.checksum import file_checksum
 from fegear.store.files import atomic_write
+from fegear.store.limit import ENV_LIMIT, cache_limit, evict, stored_entries
 
 __all__ = [
     "CACHE_TAG",
@@ -76,6 +79,7 @@ __all__ = [
     "cached_file",
     "cached_record",
     "canonical",
+    "check_cache_root",
     "RECORD_SUFFIX",
     "clear_cache",
     "code_hash",
@@ -299,8 +303,10 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         ),
         # the tetrahedra below a flank (fegear.ltca.model)
         "layer": Producer((*_MESH_CODE, "fegear.ltca.model"), _FE_DEPS),
-        # the unloaded TCA (fegear.tca.cached), its path of contact and its hand-over check
+        # the unloaded TCA (fegear.tca.cached), its reference phase, its path of contact and its
+        # hand-over check
         "tca": _TCA,
+        "phase": _TCA,
         "contact_path": _TCA,
         "handover": _TCA,
         # the synthesized spiral bevel pair (fegear.pipeline.pair)
@@ -421,6 +427,9 @@ def cached_file(
 ) -> tuple[Path, bool]:
     """Return the cached artefact for ``params``, building it with ``build(tmp_path)`` if absent.
 
+    An entry of one data file (:func:`cached_record` with an empty record): verified when read,
+    counted, and evicted as a whole.
+
     Parameters
     ----------
     kind
@@ -440,21 +449,20 @@ def cached_file(
     (path, hit)
         The artefact path and whether it came from the cache.
     """
-    key = artefact_key(kind, params, producer)
-    path = cache_dir(kind) / f"{key}{suffix}"
-    if path.exists():
-        log.info("cache hit %s/%s", kind, path.name)
-        _count(kind, True)
-        return path, True
-    atomic_write(path, build)
-    log.info("cache write %s/%s", kind, path.name)
-    _count(kind, False)
-    return path, False
+
+    data = ".data" + suffix if suffix == RECORD_SUFFIX else suffix  # the record is <key>.json
+
+    def write(entry: Entry) -> dict[str, object]:
+        entry.write(data, build)
+        return {}
+
+    entry, _, hit = cached_record(kind, params, write, producer)
+    return entry.path(data), hit
 
 
 #: Suffix of a record's JSON document.
 RECORD_SUFFIX = ".json"
-_RECORD_FORMAT = "fegear.cache_record/1"
+_RECORD_FORMAT = "fegear.cache_record/2"
 _SUFFIX = re.compile(r"^(\.[A-Za-z0-9_]+)+$")
 
 
@@ -499,21 +507,93 @@ class Entry:
 
 
 def _read_record(folder: Path, key: str) -> tuple[dict, list[str]] | None:
-    """``(record, data file suffixes)`` of a complete entry, else None (no JSON document, or a
-    data file it lists is gone)."""
+    """``(record, data file suffixes)`` of a complete, intact entry, else None.
+
+    None for no JSON document (a miss, or an entry whose writing was cut short); a data file it
+    lists that is gone, of another size, or whose checksum (:func:`~fegear.store.checksum.
+    file_checksum`) is not the one written makes the entry damaged: a warning names it, its
+    files are deleted and it is a miss (built again)."""
+    path = folder / f"{key}{RECORD_SUFFIX}"
     try:
-        doc = json.loads((folder / f"{key}{RECORD_SUFFIX}").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
         return None
+    except (OSError, ValueError) as exc:
+        return _damaged(folder, key, f"its record cannot be read ({exc})")
     if not isinstance(doc, dict) or doc.get("format") != _RECORD_FORMAT:
-        return None
-    files, record = doc.get("files"), doc.get("record")
-    if not isinstance(record, dict) or not isinstance(files, list):
-        return None
-    ok = all(
-        isinstance(f, str) and _SUFFIX.match(f) and (folder / f"{key}{f}").is_file() for f in files
+        return None  # an entry of another fegear: rebuilt under the same key
+    files, record, sizes, sums = (doc.get(k) for k in ("files", "record", "sizes", "sums"))
+    if not (isinstance(record, dict) and isinstance(files, list) and isinstance(sizes, dict)
+            and isinstance(sums, dict)):  # fmt: skip
+        return _damaged(folder, key, "its record is incomplete")
+    for f in files:
+        if not (isinstance(f, str) and _SUFFIX.match(f)):
+            return _damaged(folder, key, f"its record lists {f!r}")
+        data = folder / f"{key}{f}"
+        try:
+            size = data.stat().st_size
+        except OSError:
+            return _damaged(folder, key, f"{data.name} is missing")
+        if size != sizes.get(f):
+            return _damaged(folder, key, f"{data.name} has {size} bytes, {sizes.get(f)} written")
+        if file_checksum(data) != sums.get(f):
+            return _damaged(folder, key, f"{data.name} does not have its checksum")
+    return record, files
+
+
+def _damaged(folder: Path, key: str, why: str) -> None:
+    """Delete a damaged entry (record first), with a warning naming it; returns None."""
+    log.warning(
+        "cache entry %s/%s is damaged (%s): deleted, building it again (the cache is %s; "
+        "`fegear cache clear` empties it)",
+        folder.name,
+        key,
+        why,
+        folder.parent,
     )
-    return (record, files) if ok else None
+    for p in sorted(folder.glob(f"{key}.*"), key=lambda p: p.suffix != RECORD_SUFFIX):
+        with contextlib.suppress(OSError):
+            p.unlink()
+    return None
+
+
+def _used(folder: Path, key: str) -> None:
+    """Mark an entry used now (its record's mtime: :mod:`fegear.store.limit`) and by this
+    process (never evicted while it runs)."""
+    _IN_USE.add((folder.name, key))
+    with contextlib.suppress(OSError):
+        os.utime(folder / f"{key}{RECORD_SUFFIX}")
+
+
+#: ``(kind, key)`` of the entries this process has read or written (never evicted by it).
+_IN_USE: set[tuple[str, str]] = set()
+
+
+def _enforce_limit() -> None:
+    """Evict the least recently used entries beyond the cap (:mod:`fegear.store.limit`)."""
+    root, cap = cache_root(), cache_limit()
+    if not math.isfinite(cap):
+        return
+    gone, total = evict(root, cap, _IN_USE)
+    if gone:
+        log.info(
+            "cache: %d least recently used entries evicted (%s) to stay within %s",
+            len(gone),
+            _gb(sum(e.bytes for e in gone)),
+            _gb(cap),
+        )
+    if total > cap:
+        log.warning(
+            "the cache holds %s, above its cap of %s (%s): this run uses all of it; raise the cap "
+            "or clear the cache",
+            _gb(total),
+            _gb(cap),
+            ENV_LIMIT,
+        )
+
+
+def _gb(n: float) -> str:
+    return f"{n / 1e9:.2f} GB"
 
 
 def cached_record(
@@ -525,9 +605,13 @@ def cached_record(
     """Return the cached record for ``params``, building it with ``build(entry)`` if absent.
 
     A record is data files (written by ``build`` through :meth:`Entry.write`, each atomically)
-    and a JSON document ``<key>.json`` holding what ``build`` returns and the list of the data
-    files, written last: an entry is trusted only when that document exists and every file it
-    lists is there, so an entry cut short (by an error or a kill) is a miss and is built again.
+    and a JSON document ``<key>.json`` holding what ``build`` returns, the list of the data
+    files, their sizes and checksums (:func:`~fegear.store.checksum.file_checksum`), written
+    last: an entry is trusted only when that document exists and every file it lists is there
+    with its size and checksum, so an entry cut short (by an error or a kill) is a miss and a
+    damaged one (truncated, overwritten) is deleted with a warning and built again. Every use
+    marks the entry (its last use, for the size cap: :mod:`fegear.store.limit`); after a new
+    entry the least recently used ones beyond the cap are evicted.
 
     Parameters
     ----------
@@ -547,20 +631,31 @@ def cached_record(
         The entry (:meth:`Entry.path` of its data files), the record, and whether it came from
         the cache.
     """
-    folder, key = cache_dir(kind), artefact_key(kind, params, producer)
+    key = artefact_key(kind, params, producer)  # a kind without a producer: refused first
+    folder = cache_dir(kind)
     found = _read_record(folder, key)
     if found is not None:
         entry = Entry(folder, key, tuple(found[1]))
         log.info("cache hit %s/%s", kind, entry.record_path.name)
+        _used(folder, key)
         _count(kind, True)
         return entry, found[0], True
     entry = Entry(folder, key)
     record = dict(build(entry))  # the data files, each written atomically
-    doc = {"format": _RECORD_FORMAT, "files": list(entry.files), "record": record}
+    paths = {f: entry.path(f) for f in entry.files}
+    doc = {
+        "format": _RECORD_FORMAT,
+        "files": list(entry.files),
+        "sizes": {f: p.stat().st_size for f, p in paths.items()},
+        "sums": {f: file_checksum(p) for f, p in paths.items()},
+        "record": record,
+    }
     text = json.dumps(doc, separators=(",", ":"))
     atomic_write(entry.record_path, lambda p: p.write_text(text, encoding="utf-8"))
     log.info("cache write %s/%s", kind, entry.record_path.name)
+    _used(folder, key)
     _count(kind, False)
+    _enforce_limit()
     return entry, json.loads(text)["record"], False  # as a hit reads it (tuples become lists)
 
 
@@ -578,14 +673,17 @@ class KindInfo:
     kind
         Folder name (``"mesh"``, ``"compliance"``, ``"tca"``, …).
     files
-        Number of artefacts.
+        Number of artefact files (data files and records).
     bytes
         Their total size (bytes).
+    entries
+        Complete entries (a record and its data files).
     """
 
     kind: str
     files: int
     bytes: int
+    entries: int = 0
 
 
 @dataclass(frozen=True)
@@ -604,6 +702,10 @@ class CacheInfo:
         It is a fegear cache folder (:func:`is_cache_folder`).
     kinds
         One :class:`KindInfo` per kind folder, by name.
+    limit
+        The size cap in bytes (``inf``: none; :func:`fegear.store.limit.cache_limit`).
+    entries
+        Complete entries (artefacts with their record) in all kinds.
     """
 
     root: Path
@@ -611,6 +713,8 @@ class CacheInfo:
     exists: bool
     is_cache: bool
     kinds: tuple[KindInfo, ...]
+    limit: float = math.inf
+    entries: int = 0
 
     @property
     def files(self) -> int:
@@ -657,16 +761,54 @@ def is_cache_folder(root: Path) -> bool:
 
 
 def cache_info() -> CacheInfo:
-    """The cache root, where it comes from, and the files and bytes of each kind."""
+    """The cache root, where it comes from, its size cap, and the files and bytes of each
+    kind."""
     root = cache_root()
     source = "FEGEAR_CACHE" if os.environ.get("FEGEAR_CACHE", "").strip() else "platform"
+    limit = cache_limit()
     if not root.is_dir():
-        return CacheInfo(root, source, False, False, ())
+        return CacheInfo(root, source, False, False, (), limit)
+    stored = Counter(e.kind for e in stored_entries(root, RECORD_SUFFIX))
     kinds = []
     for folder in _kind_folders(root):
         files = _artefacts(folder)
-        kinds.append(KindInfo(folder.name, len(files), sum(f.stat().st_size for f in files)))
-    return CacheInfo(root, source, True, is_cache_folder(root), tuple(kinds))
+        size = sum(f.stat().st_size for f in files)
+        kinds.append(KindInfo(folder.name, len(files), size, stored[folder.name]))
+    entries = sum(stored.values())
+    return CacheInfo(root, source, True, is_cache_folder(root), tuple(kinds), limit, entries)
+
+
+def check_cache_root() -> Path:
+    """Refuse, before any work, a cache root fegear cannot use: not a folder, not writable (a
+    read-only mount), or a non-empty folder that is not a fegear cache (the size cap deletes
+    files in it). The message names ``FEGEAR_CACHE`` when it comes from there. Creates the
+    root (with its tag) when it is missing; returns it.
+
+    Raises
+    ------
+    InputError
+        The root is unusable (the CLI's exit code 2).
+    """
+    from fegear.store.files import check_writable_folder
+
+    root = cache_root()
+    field = "FEGEAR_CACHE" if os.environ.get("FEGEAR_CACHE", "").strip() else "cache folder"
+    check_writable_folder(root, field)
+    if root.is_dir() and any(root.iterdir()) and not is_cache_folder(root):
+        raise InputError(
+            field,
+            str(root),
+            "an empty folder or a fegear cache (the cache deletes its least recently used "
+            "files): this folder holds other files",
+        )
+    cap = cache_limit()  # a bad FEGEAR_CACHE_LIMIT is refused here too
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+        _tag(root)
+    except OSError as exc:
+        raise InputError(field, str(root), "a folder fegear can write to", str(exc)) from exc
+    log.debug("cache %s, cap %s", root, _gb(cap))
+    return root
 
 
 def clear_cache(kind: str | None = None) -> CacheInfo:
@@ -683,7 +825,7 @@ def clear_cache(kind: str | None = None) -> CacheInfo:
     """
     info = cache_info()
     if not info.exists:
-        return CacheInfo(info.root, info.source, False, False, ())
+        return CacheInfo(info.root, info.source, False, False, (), info.limit)
     if not info.is_cache:
         raise InputError(
             "cache folder",
@@ -708,4 +850,4 @@ def clear_cache(kind: str | None = None) -> CacheInfo:
             shutil.rmtree(folder, ignore_errors=True)
         gone.append(KindInfo(k.kind, n, size))
         log.info("cache clear %s: %d files, %d bytes", k.kind, n, size)
-    return CacheInfo(info.root, info.source, True, True, tuple(gone))
+    return CacheInfo(info.root, info.source, True, True, tuple(gone), info.limit)
