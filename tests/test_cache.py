@@ -178,3 +178,131 @@ def test_a_cache_of_an_older_fegear_is_recognised_by_its_layout(monkeypatch, tmp
     assert fcache.is_cache_folder(root)
     gone = fcache.clear_cache()
     assert (gone.files, gone.bytes) == (2, 6) and not any(root.iterdir())
+
+
+# --------------------------------------------------------------------------------------------
+# A cache that looks after itself: verified reads, a size cap, an unusable root refused
+# --------------------------------------------------------------------------------------------
+
+_MADE_BY = fcache.Producer(("fegear.store",))
+
+
+def _entry(kind: str, i: int, size: int, built: list[int] | None = None) -> tuple[Path, bool]:
+    """A test artefact of ``size`` bytes (``built`` collects ``i`` whenever it is built)."""
+
+    def build(p: Path) -> None:
+        if built is not None:
+            built.append(i)
+        p.write_bytes(bytes([i % 251]) * size)
+
+    return fcache.cached_file(kind, {"i": i}, ".bin", build, _MADE_BY)
+
+
+@pytest.mark.parametrize("damage", ["truncated", "overwritten", "record cut"])
+def test_a_damaged_entry_is_rebuilt_with_a_warning(monkeypatch, tmp_path, caplog, damage):
+    """What a full disk, a killed copy or a bad sector leaves: the next read finds it (size,
+    checksum, record), says so naming the cache, and builds the entry again."""
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "c"))
+    built: list[int] = []
+    path, hit = _entry("alpha", 7, 4096, built)
+    assert not hit and built == [7]
+    assert _entry("alpha", 7, 4096, built) == (path, True) and built == [7]  # verified: a hit
+    record = path.with_suffix(".json")
+    if damage == "truncated":
+        path.write_bytes(path.read_bytes()[:1000])
+    elif damage == "overwritten":  # same size, one byte changed
+        data = bytearray(path.read_bytes())
+        data[2049] ^= 0xFF
+        path.write_bytes(bytes(data))
+    else:
+        record.write_text(record.read_text()[:20])
+    with caplog.at_level("WARNING", logger="fegear.store.cache"):
+        again, hit = _entry("alpha", 7, 4096, built)
+    assert (again, hit) == (path, False) and built == [7, 7]
+    assert path.read_bytes() == bytes([7]) * 4096
+    (msg,) = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert "damaged" in msg and "alpha" in msg and str(tmp_path / "c") in msg
+    assert _entry("alpha", 7, 4096, built) == (path, True) and built == [7, 7]
+
+
+def test_a_truncated_operator_is_rebuilt_not_a_failed_run(monkeypatch, tmp_path):
+    """The operator of a body cut short on disk (``mmap length is greater than file size``
+    before the entries were verified) is computed again and equals the first one."""
+    import numpy as np
+    import skfem
+
+    from fegear.compliance import candidate_operator
+    from fegear.fem.elasticity import assemble_body
+
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "c"))
+    mesh = skfem.MeshTet.init_tensor(*(np.linspace(0, 1, 4),) * 3).with_boundaries(
+        {"bottom": lambda x: x[2] == 0.0, "top": lambda x: x[2] == 1.0}
+    )
+    body = assemble_body(mesh, 206000.0, 0.3, [("bottom", "xyz")])
+    top = np.unique(body.basis.get_dofs("top").all())
+    first = candidate_operator(body, top, "superlu", cache_key={"mesh": "cube"})
+    (npy,) = (tmp_path / "c" / "compliance").glob("*.npy")
+    G = np.array(first.blocks[0].G)
+    npy.write_bytes(npy.read_bytes()[: npy.stat().st_size // 2])
+    again = candidate_operator(body, top, "superlu", cache_key={"mesh": "cube"})
+    assert not again.cache_hit
+    np.testing.assert_array_equal(np.asarray(again.blocks[0].G), G)
+
+
+def test_the_cap_evicts_the_least_recently_used_entries(monkeypatch, tmp_path):
+    """Four entries of 1 MB under a cap of 3.5 MB: writing the fourth evicts the one used
+    longest ago, not the one read last, nor one that a running piece of work has used."""
+    root = tmp_path / "c"
+    monkeypatch.setenv("FEGEAR_CACHE", str(root))
+    monkeypatch.setenv("FEGEAR_CACHE_LIMIT", "3.5MB")
+    mb = 10**6
+    paths = [_entry("alpha", i, mb)[0] for i in range(3)]
+    for k, p in enumerate(paths):  # last uses 1000, 2000, 3000 s after the epoch
+        os.utime(p.with_suffix(".json"), (1000.0 * (k + 1),) * 2)
+    assert _entry("alpha", 0, mb)[1]  # a hit: entry 0 is now the most recently used
+    _entry("alpha", 3, mb)
+    left = sorted(p.name for p in (root / "alpha").glob("*.bin"))
+    assert left == sorted(p.name for p in (*paths[0:1], *paths[2:3], _entry("alpha", 3, mb)[0]))
+    assert not paths[1].exists() and not paths[1].with_suffix(".json").exists()
+    # inside a run (record_cache_use), its entries stay even beyond the cap
+    with fcache.record_cache_use():
+        kept = [_entry("beta", i, mb)[0] for i in range(4)]
+        assert all(p.exists() for p in kept)
+    assert fcache.cache_info().bytes < 3.5 * mb + 4 * mb
+    monkeypatch.setenv("FEGEAR_CACHE_LIMIT", "lots")
+    with pytest.raises(fcache.InputError, match="FEGEAR_CACHE_LIMIT"):
+        fcache.cache_info()
+
+
+def test_an_unusable_fegear_cache_exits_2_naming_it(monkeypatch, tmp_path, capsys):
+    """Refused before any work (the run would otherwise fail on its first write, minutes in):
+    a path under a file, a folder that cannot be written (a read-only mount, simulated: the
+    tests run as root, which writes through permissions), a non-empty folder of other files."""
+    import tempfile
+
+    (tmp_path / "file").write_text("x")
+    cases = {"under a file": tmp_path / "file" / "cache", "other files": tmp_path / "home"}
+    (tmp_path / "home").mkdir()
+    (tmp_path / "home" / "thesis.tex").write_text("precious")
+    for why, root in cases.items():
+        monkeypatch.setenv("FEGEAR_CACHE", str(root))
+        assert main(["run", str(FZG), "--fidelity", "tca", "-q", "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert "FEGEAR_CACHE" in err and str(root) in err, why
+        assert not (tmp_path / "o").exists()  # nothing was run
+    readonly = tmp_path / "ro"
+    real = tempfile.mkstemp
+
+    def mkstemp(*a, dir=None, **kw):
+        if dir is not None and Path(dir) == readonly:
+            raise OSError(30, "Read-only file system")
+        return real(*a, dir=dir, **kw)
+
+    readonly.mkdir()
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    monkeypatch.setenv("FEGEAR_CACHE", str(readonly))
+    assert main(["run", str(FZG), "--fidelity", "tca", "-q", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "FEGEAR_CACHE" in err and "Read-only file system" in err
+    assert main(["sweep", str(FZG), "--out", str(tmp_path / "s"), "-q"]) == 2
+    assert "FEGEAR_CACHE" in capsys.readouterr().err

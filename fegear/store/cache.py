@@ -391,7 +391,17 @@ class CacheUse:
         return {"folder": str(self.root), "hits": dict(self.hits), "built": dict(self.built)}
 
 
-_RECORDERS: list[tuple[Counter, Counter]] = []
+@dataclass
+class _Recorder:
+    """What one :func:`record_cache_use` block has looked up: counts per kind, and the entries
+    it used (``(kind, key)``: kept by the size cap while the block runs)."""
+
+    hits: Counter = dataclasses.field(default_factory=Counter)
+    built: Counter = dataclasses.field(default_factory=Counter)
+    pinned: set[tuple[str, str]] = dataclasses.field(default_factory=set)
+
+
+_RECORDERS: list[_Recorder] = []
 
 
 @contextlib.contextmanager
@@ -400,22 +410,24 @@ def record_cache_use() -> Iterator[Callable[[], CacheUse]]:
 
     Yields a function returning the :class:`CacheUse` so far (call it after the block for the
     whole of it). Lookups in worker processes are not seen (the artefacts of a run are looked up
-    in the main process: meshes, operators, TCA; the workers solve positions).
+    in the main process: meshes, operators, TCA; the workers solve positions). The entries used
+    inside the block are never evicted by the cache's size cap while it runs (a run's operators
+    stay however small the cap).
     """
-    hits: Counter = Counter()
-    built: Counter = Counter()
-    entry = (hits, built)
-    _RECORDERS.append(entry)
+    rec = _Recorder()
+    _RECORDERS.append(rec)
     root = cache_root()
     try:
-        yield lambda: CacheUse(root, dict(sorted(hits.items())), dict(sorted(built.items())))
+        yield lambda: CacheUse(
+            root, dict(sorted(rec.hits.items())), dict(sorted(rec.built.items()))
+        )
     finally:
-        _RECORDERS.remove(entry)
+        _RECORDERS.remove(rec)
 
 
 def _count(kind: str, hit: bool) -> None:
-    for hits, built in _RECORDERS:
-        (hits if hit else built)[kind] += 1
+    for rec in _RECORDERS:
+        (rec.hits if hit else rec.built)[kind] += 1
 
 
 def cached_file(
@@ -558,23 +570,23 @@ def _damaged(folder: Path, key: str, why: str) -> None:
 
 
 def _used(folder: Path, key: str) -> None:
-    """Mark an entry used now (its record's mtime: :mod:`fegear.store.limit`) and by this
-    process (never evicted while it runs)."""
-    _IN_USE.add((folder.name, key))
+    """Mark an entry used now (its record's mtime: :mod:`fegear.store.limit`) and by the
+    pieces of work recording their cache use (:func:`record_cache_use`: never evicted while
+    they run)."""
+    for rec in _RECORDERS:
+        rec.pinned.add((folder.name, key))
     with contextlib.suppress(OSError):
         os.utime(folder / f"{key}{RECORD_SUFFIX}")
 
 
-#: ``(kind, key)`` of the entries this process has read or written (never evicted by it).
-_IN_USE: set[tuple[str, str]] = set()
-
-
-def _enforce_limit() -> None:
-    """Evict the least recently used entries beyond the cap (:mod:`fegear.store.limit`)."""
+def _enforce_limit(written: tuple[str, str]) -> None:
+    """Evict the least recently used entries beyond the cap (:mod:`fegear.store.limit`), never
+    the entry just ``written`` nor one a running piece of work has used."""
     root, cap = cache_root(), cache_limit()
     if not math.isfinite(cap):
         return
-    gone, total = evict(root, cap, _IN_USE)
+    keep = {written}.union(*(rec.pinned for rec in _RECORDERS))
+    gone, total = evict(root, cap, keep)
     if gone:
         log.info(
             "cache: %d least recently used entries evicted (%s) to stay within %s",
@@ -655,7 +667,7 @@ def cached_record(
     log.info("cache write %s/%s", kind, entry.record_path.name)
     _used(folder, key)
     _count(kind, False)
-    _enforce_limit()
+    _enforce_limit((kind, key))
     return entry, json.loads(text)["record"], False  # as a hit reads it (tuples become lists)
 
 
