@@ -1,7 +1,11 @@
-"""Where the loaded analysis needs a fine mesh: the contact zone of a cycle, from the TCA.
+"""Which teeth the loaded analysis models: the contact zone of a cycle, from the TCA.
 
-DESIGN §6: the sector is fine "only where TCA says contact can happen", and has "enough teeth for
-every pair that can touch at the highest load plus one unloaded neighbour on each side".
+The sectors have "enough teeth for every pair that can touch at the highest load plus one
+unloaded neighbour on each side", and each is meshed fine on the whole working flank of its
+loaded teeth (:func:`fegear.ltca.build_models`; ``docs/ltca/studies.md``: the mesh does not
+depend on where the mate sits, so a study over installation errors reuses it). The zone says
+how many teeth that is, and where on the flanks the cycle's contact can reach (reported in
+``summary.json``, ``cycle.zone``).
 
 **Teeth.** Over the positions of one mesh cycle, a pair ``(k, j)`` can touch where its unloaded
 separation is at most ``gap_mm`` (the loaded approach cannot close more). The sector of each member
@@ -18,7 +22,7 @@ rated load closes 9.5 µm: modelling it would double the cost of the operators f
 grows it with the exact rule when a pair left out can close under the solved lag
 (:func:`fegear.ltca.cycle.grown_zone`).
 
-**Zone.** On every such tooth, the TCA's coarse separation cells (a regular grid of the pinion
+**Zone boxes.** On every such tooth, the TCA's coarse separation cells (a regular grid of the pinion
 flank coordinates) with separation ``<= gap_mm`` at any position, dilated by one coarse cell in
 both directions (the same dilation as the contact grids of :func:`fegear.ltca.grid.pair_cells`),
 are the pinion's zone. The gear's zone is the same set carried across the gap: the gear flank

@@ -100,6 +100,33 @@ def _cell_grid(bd, n: tuple[int, int]) -> tuple[Array, Array]:
     return bd.u_fillet + du * (np.arange(nu) + 0.5), bd.v_start + dv * (np.arange(nv) + 0.5)
 
 
+_INTERPOLATORS: dict[bytes, LinearNDInterpolator] = {}
+
+
+def _sample_interpolator(points: Array, a: Array, b: Array) -> LinearNDInterpolator:
+    """Linear interpolation of ``(a, b)`` over the 2-D ``points``, one per set of samples and
+    process (every TCA of the same gear flank, whatever its assembly, has the same samples).
+
+    The barycentric transforms of the triangles (one small LAPACK solve each, made on the first
+    interpolation) are made here on one BLAS thread: with OpenBLAS's thread pool they took
+    0.7-12 s instead of 3 ms on a 2-core machine with other processes running (measured: the
+    first ``gear_start`` of the seed face gear's TCA)."""
+    from hashlib import sha1
+
+    from scipy.spatial import Delaunay
+    from threadpoolctl import threadpool_limits
+
+    key = sha1(b"".join(np.ascontiguousarray(x).tobytes() for x in (points, a, b))).digest()
+    interp = _INTERPOLATORS.get(key)
+    if interp is None:
+        with threadpool_limits(1, user_api="blas"):
+            tri = Delaunay(points)
+            _ = tri.transform  # the per-triangle solves, now
+        interp = LinearNDInterpolator(tri, np.stack([a, b], -1))
+        _INTERPOLATORS[key] = interp
+    return interp
+
+
 class TCA:
     """TCA of one assembled pair: precomputes what does not depend on the position.
 
@@ -256,8 +283,9 @@ class TCA:
     @cached_property
     def _gear_interp(self) -> LinearNDInterpolator:
         """The gear's native parameters over ``(ρ, z)``, linear on the Delaunay triangulation of
-        its flank samples (built on first use: ~ms)."""
-        return LinearNDInterpolator(self.gtree.data, np.stack([self.ga, self.gb], -1))
+        its flank samples (:func:`_sample_interpolator`: built once per process and gear flank,
+        ~ms)."""
+        return _sample_interpolator(np.asarray(self.gtree.data), self.ga, self.gb)
 
     def gear_start(self, rho: Array, z: Array) -> tuple[Array, Array]:
         """Start values of the gear's native parameters for the Newton solves on its flank
