@@ -403,6 +403,34 @@ def _factorised(sector, body, backend: str = "auto") -> tuple[sp.csr_matrix, Spa
     return K, factor
 
 
+def _vertex_displacements(model, body, F: Array, vdofs, backend: str) -> tuple[Array, str]:
+    """``(U, solver)``: the vertex displacements ``(n_positions, n_vertices, 3)`` mm of a
+    contact sector under the consistent loads ``F`` ``(n_dofs, n_positions)`` N, and the sparse
+    backend that solved them, from the cache when the same sector was solved under the same
+    loads before (a run repeated: no factorisation), else one factorisation for all positions
+    (kept in the process, :func:`_factorised`, for the next loads on the same sector: the
+    variants of a study)."""
+    from fegear.store.cache import cached_record
+
+    params = {
+        "mesh": model.sector.path.name if model.sector.path else repr(model.sector.parameters),
+        "E": body.E,
+        "nu": body.nu,
+        "free": body.free,
+        "loads": F,
+    }
+    def build(entry) -> dict[str, object]:
+        _, factor = _factorised(model.sector, body, backend)
+        full = np.zeros_like(F)
+        full[body.free] = factor.solve(np.ascontiguousarray(F[body.free]))
+        U = np.transpose(full[vdofs], (2, 0, 1))
+        entry.write(".npy", lambda p: np.save(p, U))
+        return {"solver": factor.backend}
+
+    entry, record, _ = cached_record("fields", params, build)
+    return np.load(entry.path(".npy")), str(record["solver"])
+
+
 def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
     """``{member tooth: (q, 3) mm}``: the centres of the loaded contact cells of a position on
     each tooth of ``member`` (its frame; gear cells moved across their gap onto its flank)."""
@@ -548,7 +576,9 @@ def displacements(
         used = "none"
         loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
         K = None
-        if loaded.size:
+        if loaded.size and not (root_stress or keep_dofs):
+            U, used = _vertex_displacements(smodel, body, F, vdofs, backend)
+        elif loaded.size:
             K, factor = _factorised(smodel.sector, body, backend)
             used = factor.backend
             full[body.free] = factor.solve(np.ascontiguousarray(F[body.free]))

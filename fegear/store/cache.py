@@ -301,6 +301,11 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "compliance": Producer(
             (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.compliance"), _FE_DEPS
         ),
+        # the vertex displacements of a contact sector under a run's cell loads (for the VTK
+        # files; fegear.pipeline.run)
+        "fields": Producer(
+            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.pipeline.run"), _FE_DEPS
+        ),
         # the tetrahedra below a flank (fegear.ltca.model)
         "layer": Producer((*_MESH_CODE, "fegear.ltca.model"), _FE_DEPS),
         # the unloaded TCA (fegear.tca.cached), its reference phase, its path of contact and its
