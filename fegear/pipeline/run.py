@@ -419,6 +419,7 @@ def _vertex_displacements(model, body, F: Array, vdofs, backend: str) -> tuple[A
         "free": body.free,
         "loads": F,
     }
+
     def build(entry) -> dict[str, object]:
         _, factor = _factorised(model.sector, body, backend)
         full = np.zeros_like(F)

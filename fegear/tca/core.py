@@ -449,8 +449,13 @@ class TCA:
         return t, f
 
     # ------------------------------------------------------------------ positions
-    def positions(self, phi1: Array, with_grids: bool = True) -> list[PositionResult]:
-        """TCA at the pinion angles ``phi1 (n,)`` (rad)."""
+    def positions(
+        self, phi1: Array, with_grids: bool = True, ellipses: bool = True
+    ) -> list[PositionResult]:
+        """TCA at the pinion angles ``phi1 (n,)`` (rad); ``with_grids``: the separation grids
+        of the pairs; ``ellipses``: the contact ellipse at the contact point (curvatures by
+        finite differences of the exact flanks: ~60 % of a position's time on the face gear;
+        the searches for the ends of the path and the hand-overs do without)."""
         phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
         n, P = len(phi1), len(self.pairs)
         T = self._tooth_frames(phi1).reshape(n * P, 4, 4)
@@ -485,7 +490,11 @@ class TCA:
         gear_edge = np.where(use_edge, ee, -1).reshape(n, P)
         out = []
         for i in range(n):
-            out.append(self._position(phi1[i], theta[i], uv1[i], uv2[i], gear_edge[i], with_grids))
+            out.append(
+                self._position(
+                    phi1[i], theta[i], uv1[i], uv2[i], gear_edge[i], with_grids, ellipses
+                )
+            )
         return out
 
     def _edges_of(self, uv1: Array, uv2: Array, gear_edge: int) -> str:
@@ -509,7 +518,9 @@ class TCA:
             tags.append(f"gear:{self.edge_names[gear_edge]}")
         return ",".join(tags)
 
-    def _position(self, phi1, theta, uv1, uv2, gear_edge, with_grids) -> PositionResult:
+    def _position(
+        self, phi1, theta, uv1, uv2, gear_edge, with_grids, ellipses=True
+    ) -> PositionResult:
         a = self.asm
         valid = np.isfinite(theta)
         # a closing rotation beyond half a gear pitch is not a contact of these flanks
@@ -538,7 +549,7 @@ class TCA:
         )
         ell = (
             self._ellipse(phi1, ts, cp, uv1[cp], uv2[cp], X[cp], apply_vectors(M1k[cp], N1[cp]))
-            if has
+            if has and ellipses
             else None
         )
         grids = (

@@ -206,7 +206,7 @@ class Handover:
 def _outside(tca, phi: Array) -> NDArray[np.bool_]:
     """The rigid contact at ``phi`` is absent or on a tip/root boundary."""
     out = []
-    for p in tca.positions(np.asarray(phi, dtype=float), with_grids=False):
+    for p in tca.positions(np.asarray(phi, dtype=float), with_grids=False, ellipses=False):
         if not p.has_contact:
             out.append(True)
             continue

@@ -119,7 +119,7 @@ def _evaluate(tca: TCA, psi: Array, tol_rad: float) -> list[_Sample]:
     shift = np.clip(-shift, m_of.min(), m_of.max())
     phi1 = np.asarray(psi) + shift * tau
     out = []
-    for p, s in zip(tca.positions(phi1, with_grids=False), shift, strict=True):
+    for p, s in zip(tca.positions(phi1, with_grids=False, ellipses=False), shift, strict=True):
         i = int(np.flatnonzero(m_of == s)[0])
         out.append(_samples(tca, p, tol_rad)[i])
     return out
