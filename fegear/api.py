@@ -469,21 +469,25 @@ class GearResult:
             [np.nan if p.te_loaded_arcsec is None else p.te_loaded_arcsec for p in self.positions]
         )
 
-    def write(self, folder: str | Path) -> tuple[Path, ...]:
+    def write(self, folder: str | Path, overwrite: bool = False) -> tuple[Path, ...]:
         """Write the files of ``fegear run`` into ``folder`` (made if missing): ``summary.json``,
         ``cycle.pvd`` with ``vtk/`` (sectors, contact cells, flank views), the PNGs; each file
-        atomically, ``summary.json`` last. Returns the paths.
+        atomically, ``summary.json`` last. The folder holds one run
+        (:mod:`fegear.store.outputs`): the files of an earlier run written there are removed
+        first, and a folder with files fegear did not write is refused unless ``overwrite``
+        (then its other files are kept). Returns the paths.
 
         Raises
         ------
         InputError
-            ``folder`` cannot be written (a file, or no permission).
+            ``folder`` cannot be written (a file, or no permission), or holds other files and
+            ``overwrite`` is False.
         """
         from fegear.output.gear_output import write_gear_outputs
-        from fegear.store.files import check_writable_folder
+        from fegear.store.outputs import inspect_output_folder, output_run
 
-        out = check_writable_folder(folder, "folder")
-        return tuple(write_gear_outputs(out, self.run, self._views))
+        with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
+            return tuple(write_gear_outputs(out, self.run, self._views))
 
     def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:
         """Root stress of each tooth of ``member`` (``"pinion"``/``"gear"``) that can touch:
@@ -606,24 +610,25 @@ class HertzResult:
     warnings: tuple[str, ...] = ()
     level_result: Any = field(default=None, repr=False, compare=False)
 
-    def write(self, folder: str | Path) -> tuple[Path, ...]:
+    def write(self, folder: str | Path, overwrite: bool = False) -> tuple[Path, ...]:
         """Write the files of ``fegear run`` for the scene into ``folder`` (``summary.json``,
         ``block.vtu``, ``roller.vtu``, ``contact_cells.vtu``, ``pressure_map.png``,
-        ``convergence.png`` with a study). Returns the paths."""
+        ``convergence.png`` with a study): one run per folder, as :meth:`GearResult.write`.
+        Returns the paths."""
         from fegear.output.hertz_output import write_hertz_outputs
-        from fegear.store.files import check_writable_folder
+        from fegear.store.outputs import inspect_output_folder, output_run
 
-        out = check_writable_folder(folder, "folder")
-        return tuple(
-            write_hertz_outputs(
-                out,
-                self.case.name,
-                self.case.scene,
-                self.level_result,
-                list(self.study) or None,
-                dict(self.rates),
+        with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
+            return tuple(
+                write_hertz_outputs(
+                    out,
+                    self.case.name,
+                    self.case.scene,
+                    self.level_result,
+                    list(self.study) or None,
+                    dict(self.rates),
+                )
             )
-        )
 
 
 def _run_hertz(
@@ -690,6 +695,25 @@ def _run_hertz(
 # --------------------------------------------------------------------------------------------
 
 
+_CLEANED: set[str] = set()
+
+
+def _clean_cache_temps() -> None:
+    """Remove the temporary files that interrupted writes left in the artefact cache
+    (:func:`fegear.store.files.clean_stale_temps`: their writer is gone), once per process and
+    cache folder."""
+    from fegear.store.cache import cache_root
+    from fegear.store.files import clean_stale_temps
+
+    root = cache_root()
+    if str(root) in _CLEANED:
+        return
+    _CLEANED.add(str(root))
+    gone = clean_stale_temps(root, recursive=True)
+    if gone:
+        log.info("removed %d temporary files of interrupted writes from %s", len(gone), root)
+
+
 def run(
     case: GearCase | HertzCase,
     *,
@@ -750,6 +774,7 @@ def run(
     from fegear.store.cache import check_cache_root
 
     check_cache_root()
+    _clean_cache_temps()
     if isinstance(case, HertzCase):
         if root_stress:
             raise InputError("root_stress", root_stress, "absent for the Hertz scene (no teeth)")

@@ -330,7 +330,8 @@ def load_case(path: str | Path) -> HertzCase | GearCase:
     if not p.is_file():
         raise InputError("case", str(p), "an existing TOML file")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        # utf-8-sig: a byte-order mark (what Windows editors put at the start) is not TOML
+        data = tomllib.loads(p.read_text(encoding="utf-8-sig"))
     except tomllib.TOMLDecodeError as exc:
         raise InputError("case", str(p), "valid TOML", str(exc)) from exc
     except UnicodeDecodeError as exc:

@@ -35,6 +35,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -88,6 +89,12 @@ def _parser() -> argparse.ArgumentParser:
         help="gear pairs at fe/hybrid: also the tooth root stress (the sectors remeshed with "
         "refined fillets, one more factorisation per member: minutes and GB on large "
         "sectors); overrides the case's [analysis] root_stress",
+    )
+    r.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write into an output folder that holds files fegear did not write (they are "
+        "kept); a folder of an earlier fegear run needs no flag (its files are replaced)",
     )
     r.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     s = sub.add_parser(
@@ -182,11 +189,12 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     from fegear.io.gear_case import UNLOADED
     from fegear.ltca.fidelity import FIDELITIES
     from fegear.pipeline.run import report
-    from fegear.store.files import check_writable_folder
+    from fegear.store.outputs import inspect_output_folder
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
-    out = check_writable_folder(args.out)  # before any work
+    folder = inspect_output_folder(args.out, args.overwrite)  # before any work
+    out = folder.path
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     warned: set[str] = set()
 
@@ -245,7 +253,8 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         notify=warn,
     )
     progress("writing", None, None)
-    paths = result.write(out)
+    paths = result.write(out, overwrite=args.overwrite)
+    say(f"    {folder.describe()}")
     rep = report(result.run)
     c = result.cycle
     if result.fidelity != UNLOADED:
@@ -304,7 +313,7 @@ def _value(x: float | None, fmt: str, unit: str) -> str:
 
 def _run_hertz(args: argparse.Namespace, case) -> int:
     from fegear.api import run
-    from fegear.store.files import check_writable_folder
+    from fegear.store.outputs import inspect_output_folder
 
     study = None
     if args.study:
@@ -312,7 +321,8 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
             study = tuple(sorted({int(x) for x in args.study.split(",")}))
         except ValueError as exc:
             raise InputError("--study", args.study, "comma-separated integers") from exc
-    out = check_writable_folder(args.out)  # before any work
+    folder = inspect_output_folder(args.out, args.overwrite)  # before any work
+    out = folder.path
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr))
     fidelity = args.fidelity or case.fidelity
     level = case.level if args.level is None else args.level
@@ -352,8 +362,9 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
         f"({res.errors['b']:+.2%}), {res.level_result.n_active} active cells, "
         f"{time.perf_counter() - clock['t']:.1f} s"
     )
-    for p in res.write(out):
+    for p in res.write(out, overwrite=args.overwrite):
         say(f"wrote {p}")
+    say(folder.describe())
     return 0
 
 
@@ -411,9 +422,20 @@ def _plot(args: argparse.Namespace) -> int:
     import json
 
     from fegear.output.flank_view import plot_flank_pattern, read_flank_vtp
+    from fegear.store.outputs import MANIFEST, run_files
 
     folder = Path(args.folder)
-    files = sorted((folder / "vtk").glob(f"flank_{args.member}_*.vtp"))
+    listed = run_files(folder)  # the files of the folder's run, never a stale one of another
+    if listed is None and (folder / MANIFEST).is_file():
+        raise InputError(
+            "FOLDER", str(folder), "the output folder of a finished `fegear run`",
+            "its run did not finish (no summary.json): run it again",
+        )  # fmt: skip
+    if listed is None:  # a folder written before manifests: what is there
+        files = sorted((folder / "vtk").glob(f"flank_{args.member}_*.vtp"))
+    else:
+        pattern = re.compile(rf"^vtk/flank_{args.member}_[0-9]+\.vtp$")
+        files = sorted(folder / f for f in listed if pattern.match(f))
     if not files:
         raise InputError(
             "FOLDER",

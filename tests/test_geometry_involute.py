@@ -114,5 +114,15 @@ def test_validation_names_the_field():
         InvoluteDesign(n_teeth=2, module_mm=1.0)
     with pytest.raises(DesignError, match="profile_shift.*undercut"):
         InvoluteDesign(n_teeth=8, module_mm=1.0, profile_shift=0.0)
-    with pytest.raises(DesignError, match="tip_radius_mm.*pointed"):
+    # a tip radius that follows from the shift: the shift is named, with the shift of a pointed
+    # tip (the tooth thickness at the tip circle, closed form, vanishes there to 1e-9 rad)
+    with pytest.raises(DesignError, match=r"profile_shift.*<= 0\.6996.*pointed") as e:
         InvoluteDesign(n_teeth=10, module_mm=1.0, profile_shift=1.2)
+    from fegear.geometry.validation import _pointed_shift, _tip_half_angle
+
+    d = InvoluteDesign(n_teeth=10, module_mm=1.0, profile_shift=0.5)
+    x_max = _pointed_shift(d)  # bisection to 1e-12 in x; dψ_a/dx ~ 0.1 rad
+    assert abs(_tip_half_angle(d, x_max)) < 1e-11 and f"<= {x_max:.4f}" in str(e.value)
+    # a given tip radius is named itself
+    with pytest.raises(DesignError, match="tip_radius_mm.*pointed"):
+        InvoluteDesign(n_teeth=10, module_mm=1.0, profile_shift=0.5, tip_radius_mm=6.9)

@@ -42,7 +42,7 @@ plane. Both are found numerically on the generated surface.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import ClassVar
 
@@ -189,12 +189,15 @@ class FaceGearMember:
         """Face-gear pitch radius ``m N_2 / 2`` (where the shaper rolls without sliding)."""
         return 0.5 * self.design.n_face_gear * self.design.module_mm
 
-    def pinion(self, face_width_mm: float | None = None) -> InvoluteMember:
-        """The involute spur pinion of the drive (standard, no shift)."""
+    def pinion(
+        self, face_width_mm: float | None = None, n_teeth: int | None = None
+    ) -> InvoluteMember:
+        """The involute spur pinion of the drive (standard, no shift); ``n_teeth`` another
+        tooth count than the design's (what a refusal of its undercut quotes)."""
         d = self.design
         return InvoluteMember(
             InvoluteDesign(
-                n_teeth=d.n_pinion,
+                n_teeth=d.n_pinion if n_teeth is None else n_teeth,
                 module_mm=d.module_mm,
                 pressure_angle_deg=d.pressure_angle_deg,
                 addendum_coeff=d.addendum_coeff,
@@ -537,16 +540,54 @@ class FaceGearMember:
 
     @cached_property
     def limits(self) -> tuple[float, float]:
-        """``(L1, L2)`` in mm (cached)."""
-        L1 = self.inner_limit()
-        L2 = self.outer_limit()
+        """``(L1, L2)`` in mm (cached).
+
+        The drive scales with the module (tooth counts, angles and coefficients fixed), so the
+        limits are ``m`` times those of the same drive at module 1, found there: the Newton
+        solves on the generated surface stop at absolute tolerances (1e-12 mm, steps clipped
+        to 5 mm), which a module of metres would put out of reach."""
+        d = self.design
+        m = d.module_mm
+        if m == 1.0:
+            L1, L2 = self.inner_limit(), self.outer_limit()
+        else:
+            unit = FaceGearMember(
+                replace(
+                    d,
+                    module_mm=1.0,
+                    inner_radius_mm=d.inner_radius_mm / m,
+                    outer_radius_mm=d.outer_radius_mm / m,
+                    pinion_face_width_mm=d.pinion_face_width_mm / m,
+                    blank_thickness_mm=d.blank_thickness_mm / m,
+                )
+            )
+            L1, L2 = (m * x for x in unit.limits)
         log.info("face gear limits: L1 = %.4f mm (undercut), L2 = %.4f mm (pointing)", L1, L2)
         return L1, L2
 
     def check_limits(self) -> None:
-        """Refuse a tooth running past L1 or L2 (DesignError naming the limit and the excess)."""
+        """Refuse a tooth running past L1 or L2 (DesignError naming the field and the limit).
+
+        Where the face-gear pitch radius ``m N2/2`` lies outside the tooth (from
+        ``inner_radius_mm`` to ``outer_radius_mm``) the module does not fit the radii: the
+        refused field is ``module_mm``, with the range that puts the tooth between the limits
+        (``L1/m`` and ``L2/m`` depend on the tooth counts and angles only). Otherwise the radius
+        that runs past its limit is refused, with the limit."""
         d = self.design
         L1, L2 = self.limits
+        if not L1 <= d.inner_radius_mm or not d.outer_radius_mm <= L2:
+            m = d.module_mm
+            k1, k2 = L1 / m, L2 / m
+            lo, hi = d.outer_radius_mm / k2, d.inner_radius_mm / k1
+            if not d.inner_radius_mm <= self.pitch_radius <= d.outer_radius_mm:
+                fits = f"in [{lo:.4g}, {hi:.4g}] mm" if lo <= hi else "none: the tooth is too long"
+                raise DesignError(
+                    "module_mm", m, fits,
+                    f"the pitch radius m N2/2 = {self.pitch_radius:.6g} mm lies outside the "
+                    f"tooth ({d.inner_radius_mm:g} to {d.outer_radius_mm:g} mm): the tooth must "
+                    f"lie between the undercut limit {k1:.4f} m and the pointing limit "
+                    f"{k2:.4f} m",
+                )  # fmt: skip
         if d.inner_radius_mm < L1:
             raise DesignError(
                 "inner_radius_mm", d.inner_radius_mm, f">= {L1:.3f} mm (undercut limit L1)",

@@ -394,6 +394,69 @@ class SpiralBevelMember:
                 f"L = {L[k]:.2f} mm; about {max(est, 0.0):.2f} mm fits",
             )  # fmt: skip
 
+    def tooth_limits(self, n_L: int = 9, n_u: int = 7) -> tuple[Array, Array, Array]:
+        """``(L, top_land, singular)``: ``n_L`` cone distances toe → heel (mm), the top land
+        there (mm: the arc of the tip between the drive and the coast flank of one tooth,
+        negative where the flanks cross below the tip: a pointed tooth), and per side the
+        smallest ``|singularity|`` over the working surface relative to its largest, with the
+        sign it has where it changes sign (a zero crossing of the engine's singularity function
+        ``f_ψ − c_a f_u − c_b f_t``, :class:`~fegear.geometry.generation.Envelope`, is a
+        singular line of the generated surface: undercut, Litvin & Fuentes 2004 §6.3). Sampled
+        on ``n_u × n_L`` working-surface points per side; the tooth's sign is that of its
+        thickness at the fillet limit. Cached."""
+        key = ("tooth_limits", n_L, n_u)
+        if key not in self._cache:
+            A0, F = self.blank.outer_cone_distance, self.blank.face_width_mm
+            L = np.linspace(A0 - F, A0, n_L)
+            U, V = np.meshgrid(np.linspace(0.0, 1.0, n_u), L, indexing="ij")
+            ang, sing = {}, []
+            for side in ("drive", "coast"):
+                env = self._solve(side, U, V)[0]
+                ang[side] = np.arctan2(env.points[..., 1], env.points[..., 0])
+                f = env.singularity
+                crosses = bool(np.any(f > 0) and np.any(f < 0))
+                sing.append(-1.0 if crosses else float(np.abs(f).min() / np.abs(f).max()))
+            rho = np.hypot(env.points[-1, :, 0], env.points[-1, :, 1])
+            w = np.angle(np.exp(1j * (ang["drive"] - ang["coast"])))
+            land = np.sign(w[0]) * w[-1] * rho
+            self._cache[key] = (L, land, np.array(sing))
+        return self._cache[key]
+
+    def check_tooth(self) -> None:
+        """Refuse a pointed or undercut tooth (:meth:`tooth_limits`), naming the field.
+
+        Pointed: the top land vanishes somewhere from toe to heel. If it is positive at the heel
+        and vanishes toward the toe, a narrower face keeps it (``face_width_mm <= A0 − L0``,
+        ``L0`` where the land crosses zero, linear between the samples); else the member needs
+        more teeth (thicker teeth at the same depth). Undercut: a singular line crosses the
+        working surface; the member needs more teeth.
+
+        Raises :class:`~fegear.errors.DesignError` naming ``spiral_bevel.face_width_mm``, or
+        the member's tooth count (``spiral_bevel.n1`` / ``n2``).
+        """
+        L, land, sing = self.tooth_limits()
+        teeth = f"spiral_bevel.n{self.index}"
+        if np.any(land <= 0.0):
+            k = int(np.argmin(land))
+            where = (
+                f"the {self.name}'s top land vanishes (pointed tooth): {land[k]:.3f} mm at "
+                f"cone distance {L[k]:.2f} mm (toe {L[0]:.2f}, heel {L[-1]:.2f} mm)"
+            )
+            if land[-1] > 0.0:
+                j = int(np.flatnonzero(land <= 0.0).max())
+                L0 = L[j] + (L[j + 1] - L[j]) * (0.0 - land[j]) / (land[j + 1] - land[j])
+                raise DesignError(
+                    "spiral_bevel.face_width_mm", self.blank.face_width_mm,
+                    f"<= {self.blank.outer_cone_distance - L0:.2f} mm", where,
+                )  # fmt: skip
+            raise DesignError(teeth, self.n_teeth, "more teeth (a thicker tooth)", where)
+        if np.any(sing < 0.0):
+            raise DesignError(
+                teeth, self.n_teeth, "more teeth (a tooth without undercut)",
+                f"the {self.name}'s generated flank has singular points on its working surface "
+                "(undercut)",
+            )  # fmt: skip
+
     # ------------------------------------------------------------------ evaluation
     def _tools(self, side: Side):
         key = side
@@ -626,6 +689,7 @@ class SpiralBevelPair:
                 pair = cls._build(blank, targets, _with_edge_radius(settings, rho), reports)
         for m in (pair.pinion, pair.gear):
             m.check_fillets()  # the edge radius fits (DesignError naming it otherwise)
+            m.check_tooth()  # neither pointed nor undercut (DesignError naming the field)
         return pair
 
     @classmethod

@@ -24,6 +24,7 @@ import logging
 import math
 import multiprocessing
 import os
+import sys
 import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -134,14 +135,58 @@ def _prepare(models: MemberModels) -> float:
     return time.perf_counter() - t0
 
 
-def _worker_init(threads: int) -> None:
-    """In a forked worker: its share of the cores for the threaded half-space evaluation
-    (row blocks, each computed whole by one thread: the same numbers with any thread count), one
-    BLAS thread (:func:`_one_blas_thread`), and a heap that keeps its pages
-    (:func:`_keep_heap`)."""
+def _worker_init(threads: int, parent: int | None = None) -> None:
+    """In a forked worker: an end with its parent ``parent`` (:func:`_die_with_parent`), its
+    share of the cores for the threaded half-space evaluation (row blocks, each computed whole by
+    one thread: the same numbers with any thread count), one BLAS thread
+    (:func:`_one_blas_thread`), and a heap that keeps its pages (:func:`_keep_heap`)."""
+    if parent is not None:
+        _die_with_parent(parent)
     os.environ["FEGEAR_THREADS"] = str(threads)
     _one_blas_thread()  # for the worker's lifetime (never restored)
     _keep_heap()
+
+
+#: ``prctl`` option of Linux: the signal the calling process gets when its parent ends.
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent(parent: int, poll_s: float = 1.0) -> None:
+    """End this worker when the process that forked it (pid ``parent``) ends, however it ends
+    (SIGTERM of a job manager or ``timeout``, SIGKILL of the OOM killer): the pool's own
+    shutdown never runs then, and a worker holds some hundred MB.
+
+    On Linux the kernel sends SIGKILL to this process when its parent dies
+    (``prctl(PR_SET_PDEATHSIG, SIGKILL)``, set through ctypes); the parent may have died between
+    the fork and that call, so the parent pid is checked after it (a dead parent's orphans are
+    re-parented: ``getppid()`` no longer returns it) and the worker exits at once. The forking
+    thread is the thread that runs the pool (the caller's), alive as long as the pool is. Where
+    ``prctl`` is not available (macOS forks too), a daemon thread polls ``getppid()`` every
+    ``poll_s`` seconds and ends the process when it changes."""
+    import signal
+
+    armed = False
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        except (OSError, AttributeError):
+            armed = False
+    if os.getppid() != parent:  # the parent died before the signal was armed
+        os._exit(1)
+    if armed:
+        return
+    import threading
+
+    def watch() -> None:
+        while True:
+            time.sleep(poll_s)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="fegear-parent-watch", daemon=True).start()
 
 
 #: glibc ``mallopt`` parameters (``malloc.h``): ``M_TRIM_THRESHOLD``, ``M_MMAP_THRESHOLD``.
@@ -220,7 +265,10 @@ def _solve_all(job: CycleJob, parts: list[range], workers: int, progress) -> lis
     try:
         threads = max(1, (os.cpu_count() or 1) // workers)
         with ProcessPoolExecutor(
-            max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(threads,)
+            max_workers=workers,
+            mp_context=ctx,
+            initializer=_worker_init,
+            initargs=(threads, os.getpid()),
         ) as pool:
             futures = [pool.submit(_solve_chunk, r) for r in parts]
             k, pending = 0, set(futures)

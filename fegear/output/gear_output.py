@@ -718,28 +718,18 @@ def _plot_load_share(out: Path, run: GearRun) -> Path:
 
 
 def _plot_p_max(out: Path, run: GearRun) -> Path:
-    plt = _plt()
-    c = run.cycle
-    deg = np.degrees(c.phi1)
-    fig, ax = plt.subplots(figsize=(6.5, 4))
-    for k, v in _per_pair(run, "p_max_MPa").items():
-        ax.plot(deg, v, ".:", lw=1, label=f"pinion tooth {k:+d}")
-    ax.plot(deg, [p.p_max_MPa for p in c.positions], "k-", lw=1.5, label="position max")
-    ax.set_xlabel("pinion angle φ1 (deg)")
-    ax.set_ylabel("largest cell pressure p_max (MPa)")
+    """``p_max.png`` (:mod:`fegear.output.p_max_plot`: the values away from the edges as lines,
+    the singular edge values marked apart)."""
+    from fegear.output.p_max_plot import save_p_max
+
     rep = report(run)
     edge = (
         f"; at the edges {rep.p_max_edge_MPa:.0f} MPa (singular)"
         if rep.p_max_edge_MPa is not None
         else ""
     )
-    ax.set_title(
-        f"{_title(run)}\ncycle p_max away from the edges {_num(rep.p_max_MPa, '.0f')} MPa{edge}",
-        fontsize=9,
-    )
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    return _save(fig, out / "p_max.png")
+    title = f"{_title(run)}\ncycle p_max away from the edges {_num(rep.p_max_MPa, '.0f')} MPa{edge}"
+    return save_p_max(out / "p_max.png", run.cycle, title, _save)
 
 
 def _one_tooth(mf, phi1_deg: np.ndarray, pitch_deg: float):

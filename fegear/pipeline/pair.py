@@ -77,9 +77,11 @@ def _renamed(
         fld = f"pair.{key}"
         if member is not None and isinstance(pair.get(key), list):
             fld += f"[{member}]"
-        return type(exc)(fld, exc.value, exc.allowed)
+        return type(exc)(fld, exc.value, exc.allowed, exc.detail)
     who = {0: "pinion", 1: "gear"}.get(member, case.kind)  # type: ignore[arg-type]
-    return type(exc)(f"pair ({who} {f}, derived from the [pair] data)", exc.value, exc.allowed)
+    return type(exc)(
+        f"pair ({who} {f}, derived from the [pair] data)", exc.value, exc.allowed, exc.detail
+    )
 
 
 class FaceGearFamily:
@@ -98,13 +100,40 @@ class FaceGearFamily:
             kw["n_shaper_teeth"] = p["n_shaper"]
         try:
             fg = FaceGearMember(FaceGearDesign(**kw))
-            pinion = fg.pinion()
+        except InputError as exc:
+            raise _renamed(exc, None, self._fields, case) from exc
+        pinion = _face_gear_pinion(fg)
+        try:
+            fg.check_limits()  # undercut and pointing limits (radii, module): ~1 s, no work yet
         except InputError as exc:
             raise _renamed(exc, None, self._fields, case) from exc
         return GearPair(pinion, fg, face_gear_assembly(fg, case.errors, pinion))
 
     def assemble(self, case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:
         return face_gear_assembly(pair.gear, errors, pair.pinion)
+
+
+def _face_gear_pinion(fg):
+    """The standard (unshifted) pinion of a face-gear drive; its undercut or pointed tip
+    (:func:`fegear.geometry.validation.validate_involute`) refused naming ``pair.n_pinion`` with
+    the smallest tooth count that clears it (the pinion has no profile shift of its own)."""
+    from fegear.errors import DesignError
+
+    try:
+        return fg.pinion()
+    except DesignError as exc:
+        n = fg.design.n_pinion
+        fewest = n + 1
+        while fewest < 1000:
+            try:
+                fg.pinion(n_teeth=fewest)
+                break
+            except DesignError:
+                fewest += 1
+        raise DesignError(
+            "pair.n_pinion", n, f">= {fewest}",
+            f"the standard pinion of {n} teeth is not a valid tooth: {exc}",
+        ) from exc  # fmt: skip
 
 
 class SpurFamily:
@@ -122,6 +151,7 @@ class SpurFamily:
 
     def build(self, case: GearCase) -> GearPair:
         from fegear.geometry import InvoluteDesign, InvoluteMember
+        from fegear.geometry.validation import validate_involute_pair
 
         p = case.pair
         value = self._member_value
@@ -143,6 +173,10 @@ class SpurFamily:
                 members.append(InvoluteMember(d, name))
             except InputError as exc:
                 raise _renamed(exc, i, self._fields, case) from exc
+        try:
+            validate_involute_pair(members[0].design, members[1].design)  # tip clearance
+        except InputError as exc:
+            raise _renamed(exc, None, self._fields, case) from exc
         return GearPair(members[0], members[1], involute_assembly(*members, case.errors))
 
     def assemble(self, case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:

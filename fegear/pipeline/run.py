@@ -238,6 +238,25 @@ def _check_clearance(case: GearCase, pair: GearPair):
     )
 
 
+def _jamming(pair: GearPair, case: GearCase) -> str:
+    """The warning of a parallel-axes pair that jams (:func:`fegear.tca.engagement.jamming`),
+    else ""."""
+    from fegear.tca.engagement import jamming
+
+    if pair.assembly.kind != "parallel":
+        return ""
+    j = jamming(pair.pinion, pair.gear, case.errors)
+    if j is None:
+        return ""
+    named = ", ".join(f"{k} = {v:g}" for k, v in j.fields)
+    return (
+        f"the pair jams ({named}): its teeth are cut without backlash for the centre distance "
+        f"{j.working_mm:.4f} mm; at {j.centre_distance_mm:.4f} mm their other flanks would "
+        f"overlap by {j.depth_mm:.4f} mm along the line of action; the analysis loads the "
+        "working flanks only"
+    )
+
+
 def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) -> Engagement:
     """Every way the contact can fail, decided before the loaded analysis.
 
@@ -271,6 +290,9 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
     h = cached_handover(pair.pinion, pair.gear, pair.assembly, tca.opt, tca)
     path = cached_contact_path(pair.pinion, pair.gear, pair.assembly, tca.opt, tca, positions)
     warnings = []
+    jam = _jamming(pair, case)
+    if jam:
+        warnings.append(jam)
     lost = np.flatnonzero(~has)
     if lost.size:
         where = ", ".join(f"{i} (φ1 = {np.degrees(phi1[i]):.3f}°)" for i in lost)

@@ -337,6 +337,34 @@ def _label(it) -> str:
     return it.name
 
 
+#: TE below which a curve is numerical noise (arcsec): the TCA's Newton solves stop at
+#: :data:`fegear.tca.solve.TOL_MM` (1e-10 mm), over a lever of at least 1 mm 1e-10 rad.
+TE_NOISE_ARCSEC = 1e-10 * 180.0 / math.pi * 3600.0
+#: Half height of the y range (arcsec) of a panel whose every curve is flat within the noise.
+FLAT_HALF_RANGE_ARCSEC = 0.1
+
+
+def about_mean(te: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(te − mean, mean)`` of a TE curve (arcsec, NaN where not reported), with deviations
+    below :data:`TE_NOISE_ARCSEC` set to 0: a conjugate pair's unloaded TE is 0 up to the
+    solver's round-off (1e-10″), which a plot would otherwise draw as a ripple."""
+    te = np.asarray(te, dtype=float)
+    mean = float(np.nanmean(te)) if np.any(np.isfinite(te)) else 0.0
+    dev = te - mean
+    return np.where(np.abs(dev) < TE_NOISE_ARCSEC, 0.0, dev), mean
+
+
+def flat_limits(curves: Sequence[np.ndarray]) -> tuple[float, float] | None:
+    """The y range of a panel whose curves (:func:`about_mean`) are all flat (every finite
+    value 0): ``±FLAT_HALF_RANGE_ARCSEC``, so the flat line is drawn as one; else None
+    (matplotlib's own range)."""
+    vals = np.concatenate([np.ravel(c) for c in curves]) if curves else np.zeros(0)
+    vals = vals[np.isfinite(vals)]
+    if vals.size and np.all(vals == 0.0):
+        return (-FLAT_HALF_RANGE_ARCSEC, FLAT_HALF_RANGE_ARCSEC)
+    return None
+
+
 def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal: str | None):
     import matplotlib
 
@@ -348,6 +376,7 @@ def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal
     fig, axes = plt.subplots(1, 2 if loaded else 1, figsize=(12 if loaded else 6.5, 4.4),
                              squeeze=False)  # fmt: skip
     cmap = plt.get_cmap("viridis")
+    drawn: list[list[np.ndarray]] = [[], []]
     for i, it in enumerate(ready):
         d = docs[it.name]
         deg = [p["pinion_angle_deg"] for p in d["positions"]]
@@ -368,11 +397,18 @@ def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal
         for j, te in enumerate(curves):
             # the mean (a constant offset, large under shaft-angle errors) would hide the
             # shape and amplitude: plotted about the cycle mean, the mean in the legend
-            mean = float(np.nanmean(te)) if np.any(np.isfinite(te)) else 0.0
-            axes[0, j].plot(deg, te - mean, "os"[j] + "-", label=f"{label} (mean {mean:+.2f})",
+            dev, mean = about_mean(te)
+            drawn[j].append(dev)
+            axes[0, j].plot(deg, dev, "os"[j] + "-", label=f"{label} (mean {mean:+.2f})",
                             **style)  # fmt: skip
     titles = ["unloaded TE about its cycle mean", "loaded TE about its cycle mean"]
     for j, ax in enumerate(axes[0]):
+        flat = flat_limits(drawn[j])
+        if flat is not None:
+            ax.set_ylim(*flat)
+            ax.text(0.5, 0.9, f"flat: every curve constant within {TE_NOISE_ARCSEC:.0e}″ "
+                    "(the TCA's resolution)", transform=ax.transAxes, ha="center",
+                    fontsize=8)  # fmt: skip
         ax.set_xlabel("pinion angle φ1 (deg)")
         ax.set_ylabel("TE − mean (arcsec)")
         ax.set_title(titles[j], fontsize=10)

@@ -284,7 +284,7 @@ def _read_toml(path: Path) -> dict[str, Any]:
     from fegear.case import load_case
 
     load_case(path)  # every problem of the file itself: one InputError, as for `fegear run`
-    return tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    return tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
 
 
 def _fmt(v: Value) -> str:

@@ -9,6 +9,9 @@ the rigid TCA (no FE):
   plane / face cone; root circle / root plane / root cone), so the test needs no mesh position:
   points of one member's tip surface are carried into the mate's frame and their depth below the
   mate's root surface, within the mate's face, is measured.
+- :func:`jamming`: a parallel-axes pair whose centre distance is reduced below the working
+  centre distance of zero backlash (the one fegear cuts its involute teeth for): the teeth would
+  overlap on their non-working flanks (the pair jams), by the negative backlash.
 - :func:`handover`: the part of the mesh cycle over which the rigid contact runs inside the
   working flanks. A pair whose contact ratio is below 1 hands the load over through a tip
   (corner) contact during ``1 − ε`` of every cycle, between the interior contacts of two
@@ -29,7 +32,15 @@ from numpy.typing import NDArray
 
 from ..geometry.transforms import apply_points, compose, inverse
 
-__all__ = ["Clearance", "Handover", "cached_handover", "handover", "tip_root_clearance"]
+__all__ = [
+    "Clearance",
+    "Handover",
+    "Jamming",
+    "cached_handover",
+    "handover",
+    "jamming",
+    "tip_root_clearance",
+]
 
 Array = NDArray[np.float64]
 
@@ -161,6 +172,92 @@ def tip_root_clearance(pinion, gear, assembly, n_face: int = 41, n_turn: int = 7
     d1 = _tip_depth(b1, M1, b2, M2, n_face, n_turn)
     d2 = _tip_depth(b2, M2, b1, M1, n_face, n_turn)
     return Clearance(pinion_tip_mm=-d1, gear_tip_mm=-d2)
+
+
+# --------------------------------------------------------------------------------------------
+# Jamming of a parallel-axes pair cut without backlash
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Jamming:
+    """The negative backlash of an involute pair at its smallest centre distance (mm).
+
+    Attributes
+    ----------
+    depth_mm
+        Overlap of the non-working flanks along the line of action in the normal section
+        (``−j_bn``, > 0).
+    centre_distance_mm
+        The smallest centre distance over the face width (``a_w + Δa − |f_Σδ|/2``).
+    working_mm
+        The working centre distance of zero backlash ``a_w``.
+    fields
+        ``[(case-file key, value)]`` of the errors that reduce the centre distance.
+    """
+
+    depth_mm: float
+    centre_distance_mm: float
+    working_mm: float
+    fields: tuple[tuple[str, float], ...]
+
+
+def jamming(pinion, gear, errors) -> Jamming | None:
+    """The jamming of an external involute pair (spur, helical) under installation ``errors``,
+    or None if its teeth keep a backlash (``>= 0``).
+
+    fegear's involute teeth have the nominal thickness ``s = m (π/2 + 2 x tan α_n)`` and are
+    placed at the working centre distance of zero backlash ``a_w`` (ISO 21771: ``inv α_w = inv
+    α_t + 2 tan α_n (x1 + x2)/(z1 + z2)``). At another centre distance ``a'`` the transverse
+    backlash along the line of action is (the tooth thicknesses at the working pitch circles,
+    ``s'_i = 2 r'_i (ψ_bi − inv α')``, against the pitch ``2π r'_1/z_1``, times ``cos α'``)::
+
+        j_bt = 2 (r_b1 + r_b2)(inv α' − inv α_w),   cos α' = (r_b1 + r_b2)/a'
+
+    and ``j_bn = j_bt cos β_b`` in the normal section. ``a'`` is the smallest centre distance
+    over the face: ``Δa`` (``errors.da_mm``) less half the in-plane parallelism error
+    (``errors.f_sigma_delta_mm`` tilts the gear axis about the face centre); the out-of-plane
+    error only moves the axes apart.
+    """
+    da = float(errors.da_mm)
+    tilt = abs(float(errors.f_sigma_delta_mm))
+    fields = tuple(
+        (k, v)
+        for k, v in (("errors.da_mm", da), ("errors.f_sigma_delta_mm", tilt))
+        if (v < 0.0 if k == "errors.da_mm" else v > 0.0)
+    )
+    if not fields:
+        return None
+    d1, d2 = pinion.design, gear.design
+    at = pinion.alpha_t
+    an = math.radians(d1.pressure_angle_deg)
+    inv = math.tan(at) - at
+    inv_w = inv + 2 * math.tan(an) * (d1.profile_shift + d2.profile_shift) / (
+        d1.n_teeth + d2.n_teeth
+    )
+    rb = pinion.r_b + gear.r_b
+    aw = (pinion.r_p + gear.r_p) * math.cos(at) / math.cos(_inv_inverse(inv_w))
+    a = aw + da - 0.5 * tilt
+    if a <= rb:
+        depth = float("inf")
+    else:
+        ap = math.acos(rb / a)
+        beta_b = math.atan(math.tan(math.radians(d1.helix_angle_deg)) * math.cos(at))
+        depth = -2.0 * rb * (math.tan(ap) - ap - inv_w) * math.cos(beta_b)
+    if not depth > 0.0:
+        return None
+    return Jamming(depth_mm=depth, centre_distance_mm=a, working_mm=aw, fields=fields)
+
+
+def _inv_inverse(y: float) -> float:
+    """``α`` with ``tan α − α = y`` (Newton from ``(3y)^(1/3)``)."""
+    a = (3.0 * y) ** (1.0 / 3.0) if y > 0 else 1e-3
+    for _ in range(60):
+        f = math.tan(a) - a - y
+        a -= f / math.tan(a) ** 2
+        if abs(f) < 1e-16:
+            break
+    return a
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,0 +1,122 @@
+"""``p_max.png``: the largest pressure over the cycle, away from the flank edges, with the edge
+values marked as what they are.
+
+A pressure at a flank edge is singular (it grows with every refinement of the contact grid): it
+is not the contact's pressure and not a trend. The figure draws, per pair, its largest pressure
+away from the edges (:attr:`fegear.ltca.results.PairLoad.p_interior_MPa`) and, as the solid
+"position max" line, the largest of them at each position (a gap where a position has no
+interior value); the edge values (:attr:`~fegear.ltca.results.PairLoad.p_edge_MPa`) are separate
+markers, "singular". The y range is that of the interior values; an edge value above it is drawn
+at the top edge of the plot as an upward triangle with its value written beside it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["PMaxSeries", "p_max_series", "plot_p_max", "save_p_max"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PMaxSeries:
+    """What ``p_max.png`` draws.
+
+    Attributes
+    ----------
+    phi1_deg
+        ``(n,)`` pinion angles of the positions (deg).
+    interior
+        ``{pinion tooth: (n,) MPa}``: the pair's largest pressure away from the edges (NaN where
+        the pair carries no load or has no interior value).
+    position_max
+        ``(n,)`` MPa: the largest interior value of each position (NaN where none): the
+        "position max" line.
+    edge
+        ``(m, 3)``: ``(φ1 deg, MPa, pinion tooth)`` of every edge value (singular).
+    """
+
+    phi1_deg: Array
+    interior: dict[int, Array]
+    position_max: Array
+    edge: Array
+
+
+def p_max_series(cycle) -> PMaxSeries:
+    """The :class:`PMaxSeries` of a :class:`~fegear.ltca.results.LoadedCycle`."""
+    deg = np.degrees(np.asarray(cycle.phi1, dtype=float))
+    n = len(cycle.positions)
+    teeth = sorted({q.k for p in cycle.positions for q in p.pairs})
+    interior = {k: np.full(n, np.nan) for k in teeth}
+    edge = []
+    for i, p in enumerate(cycle.positions):
+        for q in p.pairs:
+            if not q.force_N > 0:
+                continue
+            if q.p_interior_MPa is not None:
+                interior[q.k][i] = q.p_interior_MPa
+            if q.p_edge_MPa is not None:
+                edge.append((deg[i], q.p_edge_MPa, q.k))
+    stack = np.array(list(interior.values())) if interior else np.full((1, n), np.nan)
+    with np.errstate(all="ignore"):
+        has = np.any(np.isfinite(stack), axis=0)
+        pos_max = np.where(has, np.nanmax(np.where(np.isfinite(stack), stack, -np.inf), 0), np.nan)
+    return PMaxSeries(deg, interior, pos_max, np.array(edge, dtype=float).reshape(-1, 3))
+
+
+def plot_p_max(ax, series: PMaxSeries) -> tuple[float, float] | None:
+    """Draw ``series`` on the matplotlib axes ``ax``; returns the y range set (None: matplotlib's
+    own, when no interior value exists)."""
+    for k, v in series.interior.items():
+        ax.plot(series.phi1_deg, v, ".:", lw=1, label=f"pinion tooth {k:+d}, away from the edges")
+    ax.plot(
+        series.phi1_deg,
+        series.position_max,
+        "k-",
+        lw=1.5,
+        label="position max (away from the edges)",
+    )
+    inner = series.position_max[np.isfinite(series.position_max)]
+    ylim = None
+    if inner.size:
+        top = float(inner.max())
+        ylim = (0.0, 1.15 * top if top > 0 else 1.0)
+    e = series.edge
+    if e.size:
+        top = np.inf if ylim is None else ylim[1]
+        below, above = e[e[:, 1] <= top], e[e[:, 1] > top]
+        if below.size:
+            ax.plot(below[:, 0], below[:, 1], "rx", ms=6,
+                    label="at a flank edge (singular, grid-dependent)")  # fmt: skip
+        if above.size:
+            y = 0.97 * top
+            ax.plot(above[:, 0], np.full(len(above), y), "r^", ms=6,
+                    label="at a flank edge, above the range (value beside; singular)")  # fmt: skip
+            for x, v in zip(above[:, 0], above[:, 1], strict=True):
+                ax.annotate(f"{v:.0f}", (x, y), textcoords="offset points", xytext=(0, -11),
+                            ha="center", fontsize=6, color="r")  # fmt: skip
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    return ylim
+
+
+def save_p_max(path: Path, cycle, title: str, save) -> Path:
+    """``p_max.png`` of ``cycle`` at ``path`` (``save(fig, path)`` writes and closes it)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    plot_p_max(ax, p_max_series(cycle))
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("largest cell pressure (MPa)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return save(fig, path)
