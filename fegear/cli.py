@@ -1,8 +1,9 @@
 """The ``fegear`` command.
 
 ``fegear run [CASE] [--fidelity F] [--level L] [--out DIR]`` runs a case file and writes its
-results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``). The case kind decides
-what runs:
+results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``), one run per folder
+(:mod:`fegear.store.outputs`: an earlier run's files there are replaced, a folder with other
+files needs ``--overwrite``). The case kind decides what runs:
 
 - gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity hybrid``,
   the default, ``fe`` or ``hertz``) or the unloaded TCA (``--fidelity tca``);

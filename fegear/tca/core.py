@@ -35,11 +35,17 @@ from .results import ContactEllipseAt, PositionResult, SeparationGrid
 from .solve import circle_hit, in_bounds, line_hit, wrap
 from .surfaces import FlankMap, flank_map
 
-__all__ = ["TCAOptions", "TCA"]
+__all__ = ["TCAOptions", "TCA", "TIE_RAD"]
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 _INF = np.inf
+#: Pairs whose closing rotations agree within this (rad) touch at once (conjugate pairs: the
+#: face gear's, exactly): the Newton solves stop at ``TOL_MM`` = 1e-10 mm, over a lever of 10 mm
+#: or more 1e-11 rad. The pair reported in contact among them is chosen by a rule (an interior
+#: contact before an edge contact, then the largest Hertz p0, then the first of
+#: ``pair_offsets``: :meth:`TCA._contact_pair`), not by round-off.
+TIE_RAD = 1e-11
 
 
 @dataclass(frozen=True)
@@ -527,13 +533,21 @@ class TCA:
         valid &= np.abs(np.where(valid, theta, 0.0)) < 0.5 * 2 * np.pi / a.n2
         has = bool(valid.any())
         ts = float(np.min(theta[valid])) if has else 0.0
-        cp = int(np.argmin(np.where(valid, theta, _INF))) if has else -1
+        edges = tuple(
+            self._edges_of(uv1[i], uv2[i], gear_edge[i]) if valid[i] else ""
+            for i in range(len(theta))
+        )
         Ph = a.placement1(phi1)
         Tk = tooth_transform(a.n1, self.pairs[:, 0])
         a1, b1 = self.fm1.native(uv1[:, 0], uv1[:, 1])
         P1, N1 = self.fm1.evaluate(a1, b1)
         M1k = compose(Ph[None], Tk)
         X = apply_points(M1k, P1)
+        cp, ell = -1, None
+        if has:
+            cp, ell = self._contact_pair(
+                phi1, ts, theta, valid, edges, uv1, uv2, X, M1k, N1, ellipses
+            )
         Tc = self._tooth_frames(np.array([phi1]), np.array([ts]))[0]
         # separation at each pair's closest point (closed position)
         Q, NQ = apply_points(Tc, P1), apply_vectors(Tc, N1)
@@ -543,15 +557,6 @@ class TCA:
         back_rad = np.where(valid, theta - ts, 0.0)
         if cp >= 0:
             back_mm[cp], back_rad[cp] = 0.0, 0.0
-        edges = tuple(
-            self._edges_of(uv1[i], uv2[i], gear_edge[i]) if valid[i] else ""
-            for i in range(len(theta))
-        )
-        ell = (
-            self._ellipse(phi1, ts, cp, uv1[cp], uv2[cp], X[cp], apply_vectors(M1k[cp], N1[cp]))
-            if has and ellipses
-            else None
-        )
         grids = (
             self._grids(phi1, ts, valid)
             if (with_grids and has and self.opt.separation_grid)
@@ -575,6 +580,30 @@ class TCA:
             ellipse=ell,
             grids=grids,
         )
+
+    def _contact_pair(self, phi1, ts, theta, valid, edges, uv1, uv2, X, M1k, N1, ellipses=True):
+        """``(index, ellipse)`` of the pair reported in contact: the smallest closing rotation,
+        and among pairs tied with it within :data:`TIE_RAD` (they touch at once) the one a rule
+        picks, not round-off: interior contacts before edge contacts, then the largest Hertz
+        ``p0`` with the whole load (the severe one, as the rigid TCA's Hertz reads a pair), then
+        the first of ``pair_offsets``. Without ``ellipses`` (the searches of the path's ends
+        and the hand-overs, which read the edge tags only) the ``p0`` step is skipped and the
+        ellipse is None."""
+        tied = np.flatnonzero(valid & (np.where(valid, theta, _INF) <= ts + TIE_RAD))
+        pool = [int(i) for i in tied if edges[i] == ""] or [int(i) for i in tied]
+
+        def ellipse(i: int) -> ContactEllipseAt:
+            n = apply_vectors(M1k[i], N1[i])
+            return self._ellipse(phi1, ts, i, uv1[i], uv2[i], X[i], n)
+
+        if not ellipses:
+            return pool[0], None
+        if len(pool) == 1:
+            return pool[0], ellipse(pool[0])
+        ells = [ellipse(i) for i in pool]
+        p0 = [e.hertz.p0_MPa if e.hertz is not None else -1.0 for e in ells]
+        k = int(np.argmax(p0))  # the first of the largest
+        return pool[k], ells[k]
 
     def _grids(self, phi1: float, ts: float, valid: Array) -> tuple[SeparationGrid, ...]:
         a = self.asm
