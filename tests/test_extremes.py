@@ -352,10 +352,11 @@ def test_temporary_files_of_a_killed_write_are_removed_by_the_next_run(tmp_path,
 def test_the_cache_is_cleaned_when_a_run_starts(tmp_path, monkeypatch):
     import fegear
     import fegear.api as api
+    from fegear.store.cache import check_cache_root
 
-    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path))
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
     monkeypatch.setattr(api, "_CLEANED", set())
-    kind = tmp_path / "tca"
+    kind = check_cache_root() / "tca"  # a cache (with its tag), then a kill -9 in it
     kind.mkdir()
     dead = kind / f".0123456789abcdef0123.tmp{_dead_pid()}_abcdefgh.npz"
     dead.write_text("x", encoding="utf-8")
