@@ -34,6 +34,7 @@ exit code 1.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import re
@@ -423,6 +424,7 @@ def _plot(args: argparse.Namespace) -> int:
     import json
 
     from fegear.output.flank_view import plot_flank_pattern, read_flank_vtp
+    from fegear.store.files import journal
     from fegear.store.outputs import MANIFEST, run_files
 
     folder = Path(args.folder)
@@ -458,7 +460,10 @@ def _plot(args: argparse.Namespace) -> int:
         p_max = doc["cycle"].get("p_max_MPa")
     except (OSError, ValueError, KeyError):
         pass
-    path = plot_flank_pattern(frame, patches, png, title, p_max)
+    manifest = folder / MANIFEST
+    # the PNG joins the run's outputs in the folder (the next run there replaces it too)
+    with journal(folder, manifest) if manifest.is_file() else contextlib.nullcontext():
+        path = plot_flank_pattern(frame, patches, png, title, p_max)
     if not args.quiet:
         print(f"wrote {path} (the bearing pattern over {len(files)} positions)", file=sys.stderr)
     return 0

@@ -382,9 +382,19 @@ def test_plot_draws_only_the_files_of_the_folders_run(tmp_path, monkeypatch, cap
     (out / "summary.json").write_text(json.dumps(doc), encoding="utf-8")
     read = []
     monkeypatch.setattr(fv, "read_flank_vtp", lambda f: read.append(Path(f).name) or (0, 0, 0))
-    monkeypatch.setattr(fv, "plot_flank_pattern", lambda *a: tmp_path / "p.png")
+    written = []
+
+    def fake_plot(frame, patches, png, *a):  # writes as the real one does (atomically)
+        from fegear.store.files import atomic_write
+
+        written.append(atomic_write(png, lambda q: q.write_bytes(b"png")))
+        return png
+
+    monkeypatch.setattr(fv, "plot_flank_pattern", fake_plot)
     assert main(["plot", str(out), "-q"]) == 0
     assert read == [Path(f).name for f in listed]
+    # the picture joins the run's files: the next run into the folder replaces it as well
+    assert "bearing_pattern_gear_flank.png" in (out / MANIFEST).read_text("utf-8").split()
 
 
 # --------------------------------------------------------------------------------------------
