@@ -238,13 +238,13 @@ def test_failing_item_does_not_stop_the_others(fzg3, tmp_path, capsys):
     )  # fmt: skip
     assert main(["sweep", str(bad), str(fzg3), "--out", str(out), "--fidelity", "tca"]) == 1
     err = capsys.readouterr().err
-    assert "pointed  failed: pair (gear tip_radius_mm" in err, err
+    assert "pointed  failed: pair.profile_shift[1] = 1.9" in err, err
     assert "fzg_spur  done in" in err
     doc = json.loads((out / "sweep.json").read_text())
     status = {it["name"]: it["status"] for it in doc["items"]}
     assert status == {"pointed": "failed", "fzg_spur": "done"}
     assert not (out / "pointed").exists() and not list(out.glob(".*.tmp"))
-    assert "pointed** | failed: pair (gear tip_radius_mm" in (out / "comparison.md").read_text()
+    assert "pointed** | failed: pair.profile_shift[1] = 1.9" in (out / "comparison.md").read_text()
     # the reference is the first item without errors, "pointed": it failed, so there is no
     # comparison, and the sweep says so; fzg_spur is not taken instead (issue 21)
     assert "fegear: failed: the reference item 'pointed' has no valid results" in err
