@@ -20,14 +20,12 @@ from fegear.ltca.zone import ContactZone
 
 __all__ = [
     "DEGENERATE_SHARE",
-    "EDGE_REACH_CELLS",
     "MIN_CELLS_ACROSS",
     "CycleHeadline",
     "Excluded",
     "LoadedCycle",
     "LoadedPosition",
     "PairLoad",
-    "edge_reach_mm",
 ]
 
 Array = NDArray[np.float64]
@@ -43,19 +41,6 @@ MIN_CELLS_ACROSS = 2.0
 #: resolved (a pair below it is an edge contact entering or leaving, whose grid the ``hybrid``
 #: refinement leaves alone: :data:`fegear.ltca.hybrid.MIN_REFINE_SHARE`).
 DEGENERATE_SHARE = 0.01
-#: Cells within ``EDGE_REACH_CELLS`` cell sizes (or two patch semi-minor axes, whichever is
-#: larger: :func:`edge_reach_mm`) of an active cell on a flank boundary carry the edge's
-#: singular pressure. Measured on the spiral bevel at ``hybrid`` level 0 (gear-tip edge pairs):
-#: the cells next to the edge cells read 1556-1825 MPa where the interior pairs of the same
-#: positions read 1285-1403 MPa and their Hertz value is 1361 MPa; beyond two cell sizes
-#: 1077-1341 MPa.
-EDGE_REACH_CELLS = 2.0
-
-
-def edge_reach_mm(cell_mm: Array, semi_minor_mm: float) -> float:
-    """Distance (mm) from the edge cells within which the pressure is the edge's (see
-    :data:`EDGE_REACH_CELLS`): ``max(2 max(cell sizes), 2 b)``."""
-    return max(EDGE_REACH_CELLS * float(np.max(cell_mm)), 2.0 * float(semi_minor_mm))
 
 
 @dataclass(frozen=True)
@@ -88,11 +73,12 @@ class PairLoad:
         The boundaries its active cells touch, named (:func:`fegear.ltca.grid.edge_names`:
         ``"pinion tip"``, ``"gear toe"``, ...); empty for an interior contact.
     p_interior_MPa
-        Largest pressure away from the edges: over the active cells farther than
-        :func:`edge_reach_mm` from every active cell on a boundary (all active cells of an
-        interior contact); None when no such cell exists (the whole patch is an edge contact)
-        or the patch is not resolved (``resolved`` False: its cell pressures are cell averages
-        of an unresolved patch, not a pressure).
+        Largest pressure away from the edges: over the active cells beyond the edges' reach
+        (:mod:`fegear.ltca.edges`: three patch semi-widths and two cells from every active
+        cell on a boundary; all active cells of an interior contact); None when no such cell
+        exists (the whole patch is an edge contact) or the patch is not resolved
+        (``resolved`` False: its cell pressures are cell averages of an unresolved patch, not a
+        pressure).
     p_edge_MPa
         Largest pressure within that reach of the edges (singular, grid-dependent); None for an
         interior contact.

@@ -459,6 +459,10 @@ def gear_summary(
         }
         doc["timings_s"] = {**run.seconds, **{f"ltca.{k}": v for k, v in c.seconds.items()}}
         warnings = list(rep.warnings) + sorted({w for p in c.positions for w in p.warnings})
+        doc["validity"] = {  # fegear.ltca.validity: the model's range, and where a result leaves it
+            "in_range": not any(v.exceeded for v in rep.validity),
+            "checks": [v.as_dict() for v in rep.validity],
+        }
     else:
         r = run.tca
         doc["cycle"] = {
