@@ -42,6 +42,7 @@ import numpy as np
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
+from fegear.ltca.degenerate import position_status
 from fegear.ltca.edges import edge_split
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.grid import PairCells, missing_pairs, pair_cells, take_cells
@@ -52,7 +53,6 @@ from fegear.ltca.model import (
     cell_load_operators,
 )
 from fegear.ltca.results import (
-    DEGENERATE_SHARE,
     MIN_CELLS_ACROSS,
     LoadedPosition,
     PairLoad,
@@ -255,25 +255,6 @@ def build_models(
 def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
     """The TCA position ``pos`` as a position that carries no load (``reason``: why)."""
     return LoadedPosition.lost(pos.phi1, pos.te_arcsec, bool(pos.has_contact), reason)
-
-
-def _position_status(pos, loads, cells) -> tuple[str, str]:
-    """``("ok", "")`` or ``("degenerate", why)``: a pair carrying at least
-    :data:`~fegear.ltca.results.DEGENERATE_SHARE` of the torque whose patch the cells do not
-    resolve (:data:`~fegear.ltca.results.MIN_CELLS_ACROSS`)."""
-    bad = []
-    for q, c in zip(loads, cells, strict=True):
-        if q.in_contact and not q.resolved and q.load_share >= DEGENERATE_SHARE:
-            size = float(c.cell_mm.min())
-            bad.append(
-                f"pair ({q.k}, {q.j}) carries {100 * q.load_share:.0f} % of the torque on "
-                f"{q.n_active} cell{'s' if q.n_active != 1 else ''} of {size:.3g} mm, "
-                f"{q.cells_across:.1f} across its patch (2b = {2 * q.semi_minor_mm:.3g} mm; "
-                f"at least {MIN_CELLS_ACROSS:g} needed)"
-            )
-    if bad:
-        return "degenerate", f"phi1 = {np.degrees(pos.phi1):.3f} deg: " + "; ".join(bad)
-    return "ok", ""
 
 
 def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
@@ -498,7 +479,9 @@ def solve_position(
                 resolved=bool(across >= MIN_CELLS_ACROSS),
             )
         )
-    status, reason = _position_status(pos, loads, cells)
+    status, reason = position_status(
+        pos.phi1, sol.theta, loads, [float(c.cell_mm.min()) for c in cells]
+    )
     left = left_out_pairs(pos, models, sol.theta, warnings)
     te_l = pos.te_arcsec - sol.theta / ARCSEC
     return LoadedPosition(

@@ -37,9 +37,9 @@ Array = NDArray[np.float64]
 #: 130-200″ there; ``fe`` level 0 on FZG has 0.2 cells across (126-160 MPa where line Hertz says
 #: about 1100 MPa).
 MIN_CELLS_ACROSS = 2.0
-#: A position is degenerate when a pair carrying at least this share of the torque is not
-#: resolved (a pair below it is an edge contact entering or leaving, whose grid the ``hybrid``
-#: refinement leaves alone: :data:`fegear.ltca.hybrid.MIN_REFINE_SHARE`).
+#: A position is degenerate when the loaded pairs the cells do not resolve carry together at
+#: least this share of the torque: the loaded TE is then uncertain by up to that share of the
+#: elastic lag (:mod:`fegear.ltca.degenerate`, the rule and its reason).
 DEGENERATE_SHARE = 0.01
 
 
@@ -141,10 +141,11 @@ class LoadedPosition:
         zone to hold them: :func:`fegear.ltca.cycle.grown_zone`).
     status
         ``"ok"``; ``"lost"``: no pair carries load here (the flanks do not meet, or their only
-        contact is an edge the cells do not represent); ``"degenerate"``: a pair carrying at
-        least :data:`DEGENERATE_SHARE` of the torque is not resolved (on one cell, or a grid
-        coarser than its patch). The cycle's headline TE peak-to-peak leaves out the positions
-        that are not ``"ok"`` (:meth:`LoadedCycle.headline`).
+        contact is an edge the cells do not represent); ``"degenerate"``: the loaded pairs the
+        cells do not resolve (on one cell, or a grid coarser than the patch) carry together at
+        least :data:`DEGENERATE_SHARE` of the torque (:mod:`fegear.ltca.degenerate`). The
+        cycle's headline TE peak-to-peak leaves out the positions that are not ``"ok"``
+        (:meth:`LoadedCycle.headline`).
     status_reason
         Why, in words ("" when ok).
     unloaded_contact
