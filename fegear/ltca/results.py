@@ -87,6 +87,10 @@ class PairLoad:
         on one cell; ``inf`` for the closed-form ``hertz`` fidelity).
     resolved
         ``cells_across >= MIN_CELLS_ACROSS``: the grid resolves the patch.
+    pressure_reason
+        Why the fidelity gives no pressure for this loaded pair ("" when it does): ``hertz`` at
+        a flank edge, where ``p_max_MPa`` and ``p_peak_MPa`` are NaN and ``p_interior_MPa``,
+        ``p_edge_MPa`` None.
     """
 
     k: int
@@ -106,6 +110,7 @@ class PairLoad:
     p_edge_MPa: float | None = None
     cells_across: float = math.inf
     resolved: bool = True
+    pressure_reason: str = ""
 
     @property
     def in_contact(self) -> bool:
@@ -205,7 +210,8 @@ class LoadedPosition:
 
     @property
     def p_max_MPa(self) -> float:
-        return max((p.p_max_MPa for p in self.pairs), default=0.0)
+        """The largest pressure of its pairs (those the fidelity gives: NaN ones left out)."""
+        return max((p.p_max_MPa for p in self.pairs if not math.isnan(p.p_max_MPa)), default=0.0)
 
 
 @dataclass(frozen=True)
@@ -259,7 +265,8 @@ class CycleHeadline:
         at ``p_max_edge_position`` on pair ``p_max_edge_pair``, where it touches
         ``p_max_edge_edges``; None when no usable position has an edge contact.
     edge_positions
-        Usable positions with a loaded pair at an edge.
+        Usable positions with a loaded pair at an edge (with an edge value, or none that the
+        fidelity can give: :attr:`PairLoad.pressure_reason`).
     """
 
     n_positions: int
@@ -401,9 +408,10 @@ class LoadedCycle:
                     continue
                 if q.p_interior_MPa is not None and (best is None or q.p_interior_MPa > best[0]):
                     best = (q.p_interior_MPa, i, (q.k, q.j))
-                if q.p_edge_MPa is not None:
+                if q.p_edge_MPa is not None or (q.edges and q.pressure_reason):
                     if not edge_positions or edge_positions[-1] != i:
                         edge_positions.append(i)
+                if q.p_edge_MPa is not None:
                     if edge is None or q.p_edge_MPa > edge[0]:
                         edge = (q.p_edge_MPa, i, (q.k, q.j), q.edges)
         return CycleHeadline(
