@@ -18,7 +18,7 @@ cells across: the bound is the same). Measured on the seed face gear at ``hybrid
 (light, moderate, heavy and nominal loads, the entering or leaving pair at a flank edge with
 0.4-1.3 % of the torque and 0.0-1.4 cells across): refining those pairs until they are resolved
 moves their shares by 2-43 % of themselves and the loaded TE by 0.0002-0.008″, 0.01-0.2 % of
-the lag (``tests/test_degenerate.py``, module docstring).
+the lag (``benchmarks/bench_degenerate.py``; docs/ltca/degenerate.md).
 
 ``hertz`` has no cells: its pairs are always resolved (closed-form laws).
 """
