@@ -116,7 +116,8 @@ class PairLoad:
     load_share
         Torque fraction (the shares of a position sum to 1); None at fidelity ``tca``.
     p_max_MPa
-        Largest cell pressure of the pair (MPa), edges included; None at fidelity ``tca``.
+        Largest cell pressure of the pair (MPa), edges included; None at fidelity ``tca`` and
+        where the fidelity gives no pressure (``pressure_reason``).
     p_interior_MPa, p_edge_MPa
         Largest pressure away from the flank edges and at them (singular); None where there is
         none.
