@@ -101,7 +101,7 @@ class PairLaw:
         return brentq(lambda f: self.approach(f) - delta, 0.0, hi, xtol=1e-300, rtol=4.0 * _EPS)
 
 
-def _relative_curvature(tca: TCA, pos: PositionResult, i: int):
+def _relative_curvature(tca: TCA, pos: PositionResult, i: int, native=None):
     """``(A, B)`` (1/mm, ``A <= B``) of pair ``i`` at its closest point: the relative curvature of
     the two flanks there, from each flank's principal curvatures and directions (central
     differences of the exact flank maps; the curvature tensors of both surfaces, each
@@ -125,10 +125,8 @@ def _relative_curvature(tca: TCA, pos: PositionResult, i: int):
         compose(a.placement2(pos.phi2), tooth_transform(a.n2, j)),
     )
     K, n1 = [], None
-    for fm, uv, M in zip(
-        (tca.fm1, tca.fm2), (pos.pinion_uv[i], pos.gear_uv[i]), frames, strict=True
-    ):
-        pa, pb = fm.native(uv[0], uv[1])
+    native = native if native is not None else _natives(tca, pos, [i])[i]
+    for fm, (pa, pb), M in zip((tca.fm1, tca.fm2), native, frames, strict=True):
         h = (50 * fm.step[0], 50 * fm.step[1])  # as the TCA's ellipse: 0.01 mm, 1e-3 rad
         lo, hi = fm.native_box()
         pa = float(np.clip(pa, lo[0] + h[0], hi[0] - h[0]))
@@ -154,6 +152,19 @@ def _relative_curvature(tca: TCA, pos: PositionResult, i: int):
     return float(w[0]), float(w[1])
 
 
+def _natives(tca: TCA, pos: PositionResult, idx) -> dict:
+    """Native flank parameters of the closest points of pairs ``idx``: ``{i: ((a1, b1), (a2,
+    b2))}`` on the pinion and the gear, each flank's inversion made once for all of them (the
+    face gear's is an envelope solve: one call costs as much as several points)."""
+    idx = list(idx)
+    out: dict = {i: [] for i in idx}
+    for fm, uv in ((tca.fm1, pos.pinion_uv), (tca.fm2, pos.gear_uv)):
+        a, b = fm.native(uv[idx, 0], uv[idx, 1])
+        for i, x, y in zip(idx, np.atleast_1d(a), np.atleast_1d(b), strict=True):
+            out[i].append((float(x), float(y)))
+    return out
+
+
 def _arm(tca, pos, i: int) -> float:
     """Moment arm ``h`` (mm/rad) of pair ``i``'s normal about the member-2 axis at its closest
     point; where the normal line there misses the mate's working flank (a closest point on its
@@ -176,13 +187,16 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=None):
     closes one of them (it would carry load the law cannot give)."""
     E_star = effective_modulus(E, nu, E, nu)
     out, warnings, lawless = [], [], []
+    todo = []
     for gi, g in enumerate(pos.grids):
         if only is not None and gi not in only:
             continue
         i = int(np.flatnonzero((tca.pairs[:, 0] == g.k) & (tca.pairs[:, 1] == g.j))[0])
-        if not (pos.pair_valid[i] and models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j)):
-            continue
-        curv = _relative_curvature(tca, pos, i)
+        if pos.pair_valid[i] and models.pinion.has_tooth(g.k) and models.gear.has_tooth(g.j):
+            todo.append((gi, g, i))
+    natives = _natives(tca, pos, [i for _, _, i in todo]) if todo else {}
+    for gi, g, i in todo:
+        curv = _relative_curvature(tca, pos, i, natives[i])
         h_i = _arm(tca, pos, i)
         near = pos.backlash_mm[i] < 0.05  # only a pair that could be reached matters
         if curv is None or not np.isfinite(h_i):
@@ -222,7 +236,7 @@ def pair_laws(tca, pos, models, torque2_Nmm, E, nu, only=None):
             d_ref = local.approach(torque2_Nmm / h_i)
         line = local.kind == "line"
         g_lim = b_i + (max(d_ref, 1e-4) if line else max(4.0 * d_ref, 0.02))
-        c_i, warn = _lumped(tca, pos, gi, models, g_lim, E, nu, line=line, b_i=b_i, B=B)
+        c_i, warn = _lumped(tca, pos, gi, models, g_lim, E, nu, line=line, b_i=b_i)
         if warn:
             warnings.append(f"pair ({g.k}, {g.j}): {warn}")
         local.lumped = c_i
@@ -237,7 +251,7 @@ def _moment_arm(tca, pos, i: int) -> float:
     return float(h[0])
 
 
-def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False, b_i=0.0, B=0.0):
+def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False, b_i=0.0):
     """``c = wᵀ C_FE w − wᵀ S w``, ``w`` the unit load of a line contact (uniform on the fe cells
     within separation ``g_lim``) or of a point contact (:func:`_unit_load`): see the module."""
     g = pos.grids[gi]
@@ -250,7 +264,7 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False, b_i=0.0, B=0
                 break
         weight = None if cells is None else np.ones(cells.n)
     else:
-        cells, weight = _unit_load(tca, pos, gi, i, models.cell_mm, g_lim, b_i, B)
+        cells, weight = _unit_load(tca, pos, gi, i, models.cell_mm, g_lim, b_i)
     if cells is None:
         return 0.0, "no contact cells at the closest point: lumped compliance 0"
     # the compliance operators cover the working flanks of the teeth in the sectors' contact
@@ -283,13 +297,13 @@ def _lumped(tca, pos, gi, models, g_lim, E, nu, line: bool = False, b_i=0.0, B=0
 _LOAD_RADIUS, _LOAD_FADE, _LOAD_CELL = 2.5, 0.25, 0.25
 
 
-def _unit_load(tca, pos, gi, i, h_mm, g_lim, b_i, B):
+def _unit_load(tca, pos, gi, i, h_mm, g_lim, b_i):
     """``(cells, weight)``: the cells and the (unnormalised) unit load of a point contact's
     lumped compliance (the module docstring), or ``(None, None)`` if no cell is near.
 
     The load lies where the pair can touch, on cells of ``_LOAD_CELL · h`` within
     ``R = _LOAD_RADIUS · h`` of pair ``i``'s closest point whose separation is below ``g_lim``
-    (``b_i``: the closest point's; ``B``: the larger relative curvature, 1/mm), and fades out to
+    (``b_i``: the closest point's), and fades out to
     zero over ``ρ = _LOAD_FADE · h`` towards each of those limits and towards the boundaries of
     both working flanks:
 
@@ -299,20 +313,19 @@ def _unit_load(tca, pos, gi, i, h_mm, g_lim, b_i, B):
     ``r`` the distance to the closest point, ``d`` to the nearest flank boundary, ``s`` the
     cell's separation. A cell then enters or leaves the load with zero weight as the contact
     moves from one position to the next (a hard cut by any of these limits changed the load by
-    whole cells). The cells are taken within ``g_lim + 1.5 B R²``, beyond the separation at
-    ``R``, so that the bound of :func:`fegear.ltca.grid.pair_cells` cuts nothing."""
+    whole cells); the cells :func:`fegear.ltca.grid.pair_cells` leaves out beyond ``g_lim``
+    would have none."""
     R, rho = _LOAD_RADIUS * h_mm, _LOAD_FADE * h_mm
     origin = np.asarray(pos.points[i], dtype=float)
-    reach = g_lim + 1.5 * B * R * R
     cells = None
     for grow in (1.0, 4.0, 16.0, 64.0):  # the coarse TCA grid may straddle a thin band
-        cells = pair_cells(tca, pos, gi, _LOAD_CELL * h_mm, reach * grow, max_cells=4000)
+        cells = pair_cells(tca, pos, gi, _LOAD_CELL * h_mm, g_lim * grow, max_cells=4000)
         if cells is not None and np.any(np.linalg.norm(cells.centers - origin, axis=1) < R):
             break
     if cells is None:
         return None, None
     r = np.linalg.norm(cells.centers - origin, axis=1)
-    keep = (r < R) & (cells.gap < g_lim)
+    keep = (r < R) & (cells.gap < g_lim)  # (a widened band: the cells within g_lim)
     if not keep.any():  # a valley narrower than the cells: the nearest one
         keep = r <= r.min()
     cells, r = take_cells(cells, np.flatnonzero(keep)), r[keep]
@@ -328,13 +341,17 @@ def _unit_load(tca, pos, gi, i, h_mm, g_lim, b_i, B):
 def _boundary_distance(tca, pos, i, cells) -> np.ndarray:
     """``(n,)`` mm: distance of each cell centre to the nearest boundary of the pinion's working
     flank (its ``(u, v)``) or of the gear's (the gear-flank point its normal line meets), each
-    parameter scaled by its flank's mm per unit at pair ``i``'s closest point."""
+    parameter scaled by its flank's mm per unit there (:func:`_metric`)."""
     U, V = cells.uv[:, 0], cells.uv[:, 1]
-    _, _, _, _, ok, guv = separation_at(tca, pos.phi1, -pos.te_rad, i, U, V)
+    X, N, sep, _, ok, guv = separation_at(tca, pos.phi1, -pos.te_rad, i, U, V)
     out = np.full(cells.n, np.inf)
-    for fm, uv, at in ((tca.fm1, cells.uv, pos.pinion_uv[i]), (tca.fm2, guv, pos.gear_uv[i])):
+    gear_points = X + sep[:, None] * N  # where the normal lines meet the gear's flank
+    for fm, uv, P, at in (
+        (tca.fm1, cells.uv, X, pos.pinion_uv[i]),
+        (tca.fm2, guv, gear_points, pos.gear_uv[i]),
+    ):
         b = fm.bounds
-        lu, lv = _metric(fm, float(at[0]), float(at[1]))
+        lu, lv = _metric(uv[ok], P[ok], fm, at)
         d = np.minimum.reduce(
             [
                 (uv[:, 0] - b.u_fillet) * lu,
@@ -347,17 +364,25 @@ def _boundary_distance(tca, pos, i, cells) -> np.ndarray:
     return np.where(ok, np.maximum(out, 0.0), 0.0)
 
 
-def _metric(fm, u: float, v: float) -> tuple[float, float]:
-    """mm per unit of ``u`` and ``v`` of flank map ``fm`` at ``(u, v)`` (forward differences of
-    1e-4 of the flank's extent, towards its inside)."""
+def _metric(uv: np.ndarray, P: np.ndarray, fm, at) -> tuple[float, float]:
+    """mm per unit of a flank's ``u`` and ``v`` near the cells: the columns of the least-squares
+    linear map from the cells' flank parameters ``uv`` ``(n, 2)`` to their points ``P``
+    ``(n, 3)`` (the cells span a few mm: the flank's metric is constant there to a fraction of
+    a per cent). With fewer than three cells, or cells on a line, forward differences of the
+    flank map at ``at`` (1e-4 of the flank's extent, towards its inside)."""
+    if uv.shape[0] >= 3:
+        A = np.column_stack([np.ones(uv.shape[0]), uv - uv.mean(axis=0)])
+        if np.linalg.matrix_rank(A) == 3:
+            J = np.linalg.lstsq(A, P, rcond=None)[0][1:]
+            return float(np.linalg.norm(J[0])), float(np.linalg.norm(J[1]))
     b = fm.bounds
+    u, v = float(at[0]), float(at[1])
     du, dv = 1e-4 * (b.u_tip - b.u_fillet), 1e-4 * (b.v_end - b.v_start)
     du = du if u + du <= b.u_tip else -du
     dv = dv if v + dv <= b.v_end else -dv
-    _, _, P, _ = fm.native_point(np.array([u, u + du, u]), np.array([v, v, v + dv]))
-    return float(np.linalg.norm(P[1] - P[0]) / abs(du)), float(
-        np.linalg.norm(P[2] - P[0]) / abs(dv)
-    )
+    _, _, Q, _ = fm.native_point(np.array([u, u + du, u]), np.array([v, v, v + dv]))
+    lu = float(np.linalg.norm(Q[1] - Q[0]) / abs(du))
+    return lu, float(np.linalg.norm(Q[2] - Q[0]) / abs(dv))
 
 
 def _covered(tca, pos, models, cells) -> np.ndarray:
