@@ -116,10 +116,13 @@ class PairLoad:
     load_share
         Torque fraction (the shares of a position sum to 1); None at fidelity ``tca``.
     p_max_MPa
-        Largest cell pressure of the pair (MPa), edges included; None at fidelity ``tca``.
+        Largest cell pressure of the pair (MPa), edges included; None at fidelity ``tca`` and
+        where the fidelity gives no pressure (``pressure_reason``).
     p_interior_MPa, p_edge_MPa
         Largest pressure away from the flank edges and at them (singular); None where there is
         none.
+    pressure_reason
+        Why a loaded pair has no pressure ("" when it has one): ``hertz`` at a flank edge.
     semi_major_mm, semi_minor_mm
         Equivalent-ellipse semi-axes of the loaded patch (mm).
     edge_contact
@@ -146,6 +149,7 @@ class PairLoad:
     edges: tuple[str, ...]
     contact_point_mm: tuple[float, float, float] | None
     backlash_mm: float | None = None
+    pressure_reason: str = ""
 
     @classmethod
     def _from(cls, q: Mapping[str, Any]) -> PairLoad:
@@ -168,6 +172,7 @@ class PairLoad:
             edges=tuple(edges),
             contact_point_mm=_tuple_or_none(q.get("contact_point_mm")),
             backlash_mm=_opt_float(q.get("backlash_mm")),
+            pressure_reason=str(q.get("pressure_reason", "")),
         )
 
 

@@ -281,6 +281,17 @@ def _run_gear(args: argparse.Namespace, case) -> int:
                 f"{', '.join(c.p_max_edge_edges)} (position {c.p_max_edge_position}, pair ({k}, "
                 f"{j})): singular, grid-dependent (cycle.p_max_edge_MPa)"
             )
+        elif c.positions_with_edge_contact:
+            why = next(
+                q.pressure_reason
+                for i in c.positions_with_edge_contact
+                for q in result.positions[i].pairs
+                if q.pressure_reason
+            )
+            say(
+                f"    edge contact at {len(c.positions_with_edge_contact)} of {c.n_positions} "
+                f"positions, no pressure there: {why} (positions[i].pairs[j].pressure_reason)"
+            )
     else:
         say(f"    unloaded TE p-p {_value(c.te_pp_unloaded_arcsec, '.2f', 'arcsec')} (TCA only)")
     ch = result.checks

@@ -39,12 +39,13 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from fegear.contact import solve_contact
 from fegear.errors import InputError
+from fegear.ltca.degenerate import position_status
+from fegear.ltca.edges import edge_split
 from fegear.ltca.fidelity import Fidelity, fidelity_of
-from fegear.ltca.grid import PairCells, edge_names, missing_pairs, pair_cells, take_cells
+from fegear.ltca.grid import PairCells, missing_pairs, pair_cells, take_cells
 from fegear.ltca.hybrid import hybrid_displacement, refined_sizes
 from fegear.ltca.model import (
     MemberModel,
@@ -52,11 +53,9 @@ from fegear.ltca.model import (
     cell_load_operators,
 )
 from fegear.ltca.results import (
-    DEGENERATE_SHARE,
     MIN_CELLS_ACROSS,
     LoadedPosition,
     PairLoad,
-    edge_reach_mm,
 )
 from fegear.ltca.warm import active_guess, footprint, likely_cells, ring_cells
 from fegear.ltca.zone import ContactZone, contact_zone, left_out_pairs
@@ -268,53 +267,6 @@ def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
     return LoadedPosition.lost(pos.phi1, pos.te_arcsec, bool(pos.has_contact), reason)
 
 
-def _edge_split(c: PairCells, act, p, semi_minor: float, b1, b2):
-    """``(edges, p_interior, p_edge)`` of one loaded pair: the boundaries its active cells touch
-    (named), the largest pressure of the active cells farther than
-    :func:`~fegear.ltca.results.edge_reach_mm` from every active boundary cell, and the largest
-    within that reach (None for an interior contact). Distances in the pair's flank-plane
-    coordinates ``c.local``.
-
-    The pressure away from the edge is the pair's interior value only where the patch has an
-    interior: at least the pair's mean pressure (force over loaded area; a Hertz patch peaks at
-    1.5 times its mean, a line contact at 1.27 times). Below it, the cells away from the edge are
-    the tail of a patch sitting on the edge, and the value is None: measured on FZG with a
-    0.5 mm axis tilt (corner contacts at a face end), the cells beyond the reach read 94 MPa
-    where the pair's mean pressure is about 3000 MPa and its edge cells 14-17 GPa."""
-    mask = c.boundary_edges if c.boundary_edges is not None else c.boundary.astype(np.uint8)
-    on_edge = act & (mask != 0)
-    if not on_edge.any():
-        return (), float(p[act].max()), None
-    reach = edge_reach_mm(c.cell_mm, semi_minor)
-    d = cKDTree(c.local[on_edge]).query(c.local)[0]
-    far = act & (d > reach)
-    near = act & ~far
-    p_int = float(p[far].max()) if far.any() else None
-    p_mean = float((p * c.area)[act].sum() / c.area[act].sum())
-    if p_int is not None and p_int < p_mean:
-        p_int = None  # the tail of an edge contact, not an interior
-    return edge_names(mask[on_edge], b1, b2), p_int, float(p[near].max())
-
-
-def _position_status(pos, loads, cells) -> tuple[str, str]:
-    """``("ok", "")`` or ``("degenerate", why)``: a pair carrying at least
-    :data:`~fegear.ltca.results.DEGENERATE_SHARE` of the torque whose patch the cells do not
-    resolve (:data:`~fegear.ltca.results.MIN_CELLS_ACROSS`)."""
-    bad = []
-    for q, c in zip(loads, cells, strict=True):
-        if q.in_contact and not q.resolved and q.load_share >= DEGENERATE_SHARE:
-            size = float(c.cell_mm.min())
-            bad.append(
-                f"pair ({q.k}, {q.j}) carries {100 * q.load_share:.0f} % of the torque on "
-                f"{q.n_active} cell{'s' if q.n_active != 1 else ''} of {size:.3g} mm, "
-                f"{q.cells_across:.1f} across its patch (2b = {2 * q.semi_minor_mm:.3g} mm; "
-                f"at least {MIN_CELLS_ACROSS:g} needed)"
-            )
-    if bad:
-        return "degenerate", f"phi1 = {np.degrees(pos.phi1):.3f} deg: " + "; ".join(bad)
-    return "ok", ""
-
-
 def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
     """Could a point left out (separation above ``g_max``) close under the lag ``θ``? Only if
     its rigid gap ``g − θ h`` is negative (the elastic term ``C F`` opens it further). Tested
@@ -511,7 +463,7 @@ def solve_position(
                 )
                 warnings.append(msg)
             p_peak = pm.p_peak
-            edges, p_int, p_edge = _edge_split(c, act, p, pm.semi_minor, b1, b2)
+            edges, p_int, p_edge = edge_split(c, act, p, pm.semi_minor, b1, b2)
             if across < MIN_CELLS_ACROSS:
                 p_int = None  # a cell average over an unresolved patch is not a pressure
         else:
@@ -537,7 +489,9 @@ def solve_position(
                 resolved=bool(across >= MIN_CELLS_ACROSS),
             )
         )
-    status, reason = _position_status(pos, loads, cells)
+    status, reason = position_status(
+        pos.phi1, sol.theta, loads, [float(c.cell_mm.min()) for c in cells]
+    )
     left = left_out_pairs(pos, models, sol.theta, warnings)
     te_l = pos.te_arcsec - sol.theta / ARCSEC
     return LoadedPosition(

@@ -272,6 +272,76 @@ def near_cells(pos: PositionResult, grid_index: int, g_max: float) -> NDArray[np
     return near
 
 
+def _boundary_mask(CU, CV, A, size, inside, ok, guv, b, b2) -> NDArray[np.uint8]:
+    """``(nξ, nη)`` uint8 :data:`EDGE_TAGS` bits of the grid cells on a working-flank boundary.
+
+    A cell is on a boundary when it is the last cell of its row or column before it: it reaches
+    the boundary, or its neighbour one cell further (along ``±ξ`` or ``±η``) has its centre off
+    the pinion's working flank (the pinion bits, by the side the neighbour leaves by) or on the
+    pinion's flank but off the gear's (its normal misses the gear's working flank: the gear bit
+    of the gear boundary nearest the cell's gear coordinates). The grid keeps only cells whose
+    centre lies on both flanks, so between its last cell and a boundary lies a strip of up to
+    one cell that no cell covers, and a boundary oblique to the cell axes staggers that last
+    cell from row to row: a contact reaching the boundary loads the last cell of each row, not a
+    cell touching the boundary (FZG at 400 N·m on the gear: the pinion-tip contact loaded cells
+    one to half a cell short of the tip, which no test of a cell reaching the tip marked).
+    ``CU, CV``: the cell centres' flank parameters, ``A`` the map ``(ξ, η) → (u, v)``, ``size``
+    the cell sizes ``(s_ξ, s_η)`` mm, ``inside``/``ok`` the grid points on the pinion's flank and
+    whose normal meets the gear's, ``guv`` their gear flank parameters, ``b``/``b2`` the
+    pinion's and the gear's flank bounds."""
+    du, dv = size
+    tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
+    hu = 0.5 * (abs(A[0, 0]) * du + abs(A[0, 1]) * dv)  # half extent of a cell along u, v
+    hv = 0.5 * (abs(A[1, 0]) * du + abs(A[1, 1]) * dv)
+    su, sv = 0.01 * (b2.u_tip - b2.u_fillet), 0.01 * (b2.v_end - b2.v_start)
+    touches = [
+        CU - hu <= b.u_fillet + tu,
+        CU + hu >= b.u_tip - tu,
+        CV - hv <= b.v_start + tv,
+        CV + hv >= b.v_end - tv,
+        guv[..., 0] <= b2.u_fillet + su,
+        guv[..., 0] >= b2.u_tip - su,
+        guv[..., 1] <= b2.v_start + sv,
+        guv[..., 1] >= b2.v_end - sv,
+    ]
+    # the gear boundary nearest each cell, in units of the gear flank's extent
+    d2 = np.stack(
+        [
+            (guv[..., 0] - b2.u_fillet) / (b2.u_tip - b2.u_fillet),
+            (b2.u_tip - guv[..., 0]) / (b2.u_tip - b2.u_fillet),
+            (guv[..., 1] - b2.v_start) / (b2.v_end - b2.v_start),
+            (b2.v_end - guv[..., 1]) / (b2.v_end - b2.v_start),
+        ]
+    )
+    nearest = np.argmin(d2, axis=0)
+    miss = inside & ~ok  # on the pinion's flank, off the gear's
+    nx, ny = CU.shape
+    for axis, step in ((0, 1), (0, -1), (1, 1), (1, -1)):
+        col = 0 if axis == 0 else 1
+        s = du if axis == 0 else dv
+        nu = CU + step * A[0, col] * s  # the neighbour's centre
+        nv = CV + step * A[1, col] * s
+        touches[0] |= nu < b.u_fillet
+        touches[1] |= nu > b.u_tip
+        touches[2] |= nv < b.v_start
+        touches[3] |= nv > b.v_end
+        off = np.zeros_like(miss)  # the neighbour is on the pinion's flank, off the gear's
+        if axis == 0 and step == 1:
+            off[:-1] = miss[1:]
+        elif axis == 0:
+            off[1:] = miss[:-1]
+        elif step == 1:
+            off[:, :-1] = miss[:, 1:]
+        else:
+            off[:, 1:] = miss[:, :-1]
+        for k in range(4):
+            touches[4 + k] |= off & (nearest == k)
+    mask = np.zeros(CU.shape, dtype=np.uint8)
+    for bit, t in enumerate(touches):
+        mask |= (t & inside).astype(np.uint8) << np.uint8(bit)
+    return mask
+
+
 def pair_cells(
     tca: TCA,
     pos: PositionResult,
@@ -385,26 +455,7 @@ def pair_cells(
     edges = np.stack([rx * cu_mm, ry * cv_mm], axis=1)
     local = _patch_coordinates(X[keep], N[keep], edges, np.asarray(pos.points[ip], dtype=float))
     du, dv = cu_mm, cv_mm  # cell sizes along ξ, η (mm)
-    # Cells touching a working-flank boundary of the pinion or the gear, and which one
-    # (EDGE_TAGS: one bit per member and boundary).
-    tu, tv = 1e-9 * (b.u_tip - b.u_fillet), 1e-9 * (b.v_end - b.v_start)
-    hu = 0.5 * (abs(A[0, 0]) * du + abs(A[0, 1]) * dv)  # half extent of a cell along u, v
-    hv = 0.5 * (abs(A[1, 0]) * du + abs(A[1, 1]) * dv)
-    b2 = tca.fm2.bounds
-    su, sv = 0.01 * (b2.u_tip - b2.u_fillet), 0.01 * (b2.v_end - b2.v_start)
-    touches = (
-        CU - hu <= b.u_fillet + tu,
-        CU + hu >= b.u_tip - tu,
-        CV - hv <= b.v_start + tv,
-        CV + hv >= b.v_end - tv,
-        guv[..., 0] <= b2.u_fillet + su,
-        guv[..., 0] >= b2.u_tip - su,
-        guv[..., 1] <= b2.v_start + sv,
-        guv[..., 1] >= b2.v_end - sv,
-    )
-    mask = np.zeros(CU.shape, dtype=np.uint8)
-    for bit, t in enumerate(touches):
-        mask |= (t & inside).astype(np.uint8) << np.uint8(bit)
+    mask = _boundary_mask(CU, CV, A, (du, dv), inside, ok, guv, b, tca.fm2.bounds)
     return PairCells(
         k=int(g.k),
         j=int(g.j),

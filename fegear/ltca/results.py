@@ -20,14 +20,12 @@ from fegear.ltca.zone import ContactZone
 
 __all__ = [
     "DEGENERATE_SHARE",
-    "EDGE_REACH_CELLS",
     "MIN_CELLS_ACROSS",
     "CycleHeadline",
     "Excluded",
     "LoadedCycle",
     "LoadedPosition",
     "PairLoad",
-    "edge_reach_mm",
 ]
 
 Array = NDArray[np.float64]
@@ -39,23 +37,10 @@ Array = NDArray[np.float64]
 #: 130-200″ there; ``fe`` level 0 on FZG has 0.2 cells across (126-160 MPa where line Hertz says
 #: about 1100 MPa).
 MIN_CELLS_ACROSS = 2.0
-#: A position is degenerate when a pair carrying at least this share of the torque is not
-#: resolved (a pair below it is an edge contact entering or leaving, whose grid the ``hybrid``
-#: refinement leaves alone: :data:`fegear.ltca.hybrid.MIN_REFINE_SHARE`).
+#: A position is degenerate when the loaded pairs the cells do not resolve carry together at
+#: least this share of the torque: the loaded TE is then uncertain by up to that share of the
+#: elastic lag (:mod:`fegear.ltca.degenerate`, the rule and its reason).
 DEGENERATE_SHARE = 0.01
-#: Cells within ``EDGE_REACH_CELLS`` cell sizes (or two patch semi-minor axes, whichever is
-#: larger: :func:`edge_reach_mm`) of an active cell on a flank boundary carry the edge's
-#: singular pressure. Measured on the spiral bevel at ``hybrid`` level 0 (gear-tip edge pairs):
-#: the cells next to the edge cells read 1556-1825 MPa where the interior pairs of the same
-#: positions read 1285-1403 MPa and their Hertz value is 1361 MPa; beyond two cell sizes
-#: 1077-1341 MPa.
-EDGE_REACH_CELLS = 2.0
-
-
-def edge_reach_mm(cell_mm: Array, semi_minor_mm: float) -> float:
-    """Distance (mm) from the edge cells within which the pressure is the edge's (see
-    :data:`EDGE_REACH_CELLS`): ``max(2 max(cell sizes), 2 b)``."""
-    return max(EDGE_REACH_CELLS * float(np.max(cell_mm)), 2.0 * float(semi_minor_mm))
 
 
 @dataclass(frozen=True)
@@ -88,11 +73,12 @@ class PairLoad:
         The boundaries its active cells touch, named (:func:`fegear.ltca.grid.edge_names`:
         ``"pinion tip"``, ``"gear toe"``, ...); empty for an interior contact.
     p_interior_MPa
-        Largest pressure away from the edges: over the active cells farther than
-        :func:`edge_reach_mm` from every active cell on a boundary (all active cells of an
-        interior contact); None when no such cell exists (the whole patch is an edge contact)
-        or the patch is not resolved (``resolved`` False: its cell pressures are cell averages
-        of an unresolved patch, not a pressure).
+        Largest pressure away from the edges: over the active cells beyond the edges' reach
+        (:mod:`fegear.ltca.edges`: three patch semi-widths and two cells from every active
+        cell on a boundary; all active cells of an interior contact); None when no such cell
+        exists (the whole patch is an edge contact) or the patch is not resolved
+        (``resolved`` False: its cell pressures are cell averages of an unresolved patch, not a
+        pressure).
     p_edge_MPa
         Largest pressure within that reach of the edges (singular, grid-dependent); None for an
         interior contact.
@@ -101,6 +87,10 @@ class PairLoad:
         on one cell; ``inf`` for the closed-form ``hertz`` fidelity).
     resolved
         ``cells_across >= MIN_CELLS_ACROSS``: the grid resolves the patch.
+    pressure_reason
+        Why the fidelity gives no pressure for this loaded pair ("" when it does): ``hertz`` at
+        a flank edge, where ``p_max_MPa`` and ``p_peak_MPa`` are NaN and ``p_interior_MPa``,
+        ``p_edge_MPa`` None.
     """
 
     k: int
@@ -120,6 +110,7 @@ class PairLoad:
     p_edge_MPa: float | None = None
     cells_across: float = math.inf
     resolved: bool = True
+    pressure_reason: str = ""
 
     @property
     def in_contact(self) -> bool:
@@ -155,10 +146,11 @@ class LoadedPosition:
         zone to hold them: :func:`fegear.ltca.cycle.grown_zone`).
     status
         ``"ok"``; ``"lost"``: no pair carries load here (the flanks do not meet, or their only
-        contact is an edge the cells do not represent); ``"degenerate"``: a pair carrying at
-        least :data:`DEGENERATE_SHARE` of the torque is not resolved (on one cell, or a grid
-        coarser than its patch). The cycle's headline TE peak-to-peak leaves out the positions
-        that are not ``"ok"`` (:meth:`LoadedCycle.headline`).
+        contact is an edge the cells do not represent); ``"degenerate"``: the loaded pairs the
+        cells do not resolve (on one cell, or a grid coarser than the patch) carry together at
+        least :data:`DEGENERATE_SHARE` of the torque (:mod:`fegear.ltca.degenerate`). The
+        cycle's headline TE peak-to-peak leaves out the positions that are not ``"ok"``
+        (:meth:`LoadedCycle.headline`).
     status_reason
         Why, in words ("" when ok).
     unloaded_contact
@@ -218,7 +210,8 @@ class LoadedPosition:
 
     @property
     def p_max_MPa(self) -> float:
-        return max((p.p_max_MPa for p in self.pairs), default=0.0)
+        """The largest pressure of its pairs (those the fidelity gives: NaN ones left out)."""
+        return max((p.p_max_MPa for p in self.pairs if not math.isnan(p.p_max_MPa)), default=0.0)
 
 
 @dataclass(frozen=True)
@@ -272,7 +265,8 @@ class CycleHeadline:
         at ``p_max_edge_position`` on pair ``p_max_edge_pair``, where it touches
         ``p_max_edge_edges``; None when no usable position has an edge contact.
     edge_positions
-        Usable positions with a loaded pair at an edge.
+        Usable positions with a loaded pair at an edge (with an edge value, or none that the
+        fidelity can give: :attr:`PairLoad.pressure_reason`).
     """
 
     n_positions: int
@@ -414,9 +408,10 @@ class LoadedCycle:
                     continue
                 if q.p_interior_MPa is not None and (best is None or q.p_interior_MPa > best[0]):
                     best = (q.p_interior_MPa, i, (q.k, q.j))
-                if q.p_edge_MPa is not None:
+                if q.p_edge_MPa is not None or (q.edges and q.pressure_reason):
                     if not edge_positions or edge_positions[-1] != i:
                         edge_positions.append(i)
+                if q.p_edge_MPa is not None:
                     if edge is None or q.p_edge_MPa > edge[0]:
                         edge = (q.p_edge_MPa, i, (q.k, q.j), q.edges)
         return CycleHeadline(

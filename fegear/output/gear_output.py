@@ -161,8 +161,8 @@ def _pair_row(q, k: int) -> dict[str, Any]:
         "force_N": q.force_N,
         "torque_Nm": q.torque_Nmm / 1000.0,
         "load_share": q.load_share,
-        "p_max_MPa": q.p_max_MPa,
-        "p_peak_MPa": q.p_peak_MPa,
+        "p_max_MPa": _f(q.p_max_MPa),  # None where the fidelity gives no pressure (reason)
+        "p_peak_MPa": _f(q.p_peak_MPa),
         "semi_major_mm": q.semi_major_mm,
         "semi_minor_mm": q.semi_minor_mm,
         "n_active_cells": q.n_active,
@@ -170,6 +170,7 @@ def _pair_row(q, k: int) -> dict[str, Any]:
         "edges": list(q.edges),
         "p_interior_MPa": _f_or_none(q.p_interior_MPa),
         "p_edge_MPa": _f_or_none(q.p_edge_MPa),
+        "pressure_reason": q.pressure_reason,
         "cells_across_patch": _f_or_none(q.cells_across),
         "resolved": bool(q.resolved),
         "in_contact": loaded,
@@ -459,6 +460,10 @@ def gear_summary(
         }
         doc["timings_s"] = {**run.seconds, **{f"ltca.{k}": v for k, v in c.seconds.items()}}
         warnings = list(rep.warnings) + sorted({w for p in c.positions for w in p.warnings})
+        doc["validity"] = {  # fegear.ltca.validity: the model's range, and where a result leaves it
+            "in_range": not any(v.exceeded for v in rep.validity),
+            "checks": [v.as_dict() for v in rep.validity],
+        }
     else:
         r = run.tca
         doc["cycle"] = {

@@ -43,6 +43,7 @@ from fegear.errors import DesignError, InputError
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase, error_fields
 from fegear.linalg.solve import SparseFactor, factorize_spd
 from fegear.ltca.fidelity import Fidelity, fidelity_of
+from fegear.ltca.validity import ValidityCheck, validity_checks
 from fegear.pipeline.pair import GearPair, assemble, build_pair
 
 __all__ = [
@@ -827,6 +828,8 @@ class Report:
         with an edge contact.
     interior_fraction
         Part of the cycle with interior unloaded contact (the contact ratio when below 1).
+    validity
+        The checks of the model's validity range (:mod:`fegear.ltca.validity`; loaded runs).
     warnings
         Warnings for the terminal (and ``summary.json``), in order.
     """
@@ -851,6 +854,7 @@ class Report:
     edge_positions: tuple[int, ...] = ()
     interior_fraction: float | None = None
     warnings: tuple[str, ...] = ()
+    validity: tuple[ValidityCheck, ...] = ()
 
 
 def _angles(phi1, idx) -> str:
@@ -943,6 +947,10 @@ def report(run: GearRun) -> Report:
         warnings.append(f"loaded TE peak-to-peak not reported: {te_l_why}")
     if h.p_max_MPa is None:
         warnings.append(f"p_max not reported: {h.p_max_reason}")
+    checks = validity_checks(
+        c, float(run.case.pair["module_mm"]), run.case.kind, h.p_max_MPa, h.p_max_position
+    )
+    warnings += [v.text for v in checks if v.exceeded]
     return Report(
         n_positions=n,
         te_pp_unloaded_arcsec=te_u,
@@ -964,4 +972,5 @@ def report(run: GearRun) -> Report:
         edge_positions=h.edge_positions,
         interior_fraction=frac,
         warnings=tuple(warnings),
+        validity=checks,
     )
