@@ -398,15 +398,25 @@ def ellipses(
     return tuple(out)
 
 
-def outline(e: EllipseAt, member: str, which: str = "paint", n: int = 73) -> Array | None:
+def outline(
+    e: EllipseAt,
+    member: str,
+    which: str = "paint",
+    n: int = 73,
+    axes: tuple[float, float] | None = None,
+) -> Array | None:
     """``(n, 2)`` flank coordinates ``(u, v)`` of an ellipse's boundary on ``member``'s flank.
 
-    ``which``: ``"paint"`` (the instantaneous ellipse) or ``"hertz"``. The tangent-plane ellipse
+    ``which``: ``"paint"`` (the instantaneous ellipse) or ``"hertz"``; ``axes``: other semi-axes
+    ``(a, b)`` (mm) drawn along the same principal directions instead (e.g. a published ellipse
+    at this contact point). The tangent-plane ellipse
     ``a cos t ξ + b sin t η`` is taken to flank coordinates through the pseudo-inverse of the
     flank tangents at the contact point (first order: exact for the plane, within the flank's
     second-order height over the ellipse elsewhere). None where there is no such ellipse.
     """
-    if which == "paint":
+    if axes is not None:
+        a, b = axes
+    elif which == "paint":
         if e.paint_a_mm is None:
             return None
         a, b = e.paint_a_mm, e.paint_b_mm
