@@ -133,6 +133,7 @@ class ContactCurvature:
 
     @property
     def line_contact(self) -> bool:
+        """``k_a <= 1e-9 k_b`` (or ``k_b <= 0``): conjugate flanks touching along a line."""
         return not self.A > LINE_CONTACT_RATIO * max(self.B, 1e-300) or not self.B > 0
 
 
