@@ -218,6 +218,13 @@ Ratio = fegear / reference; a trend row gives its values at the three loads and 
 quantity grew. The seconds under "Rows" are the wall time of each run with the artefact cache as
 this run found it (meshes and operators built once are read back later): not a benchmark.
 
+The two papers fegear was built from are checked number by number on their own pages, each
+generated the same way: [the face-gear paper](papers/face_gear_2013.md) (its Tables 1-3, the TE
+at three loads, Δγ = ±0.02°, the shaper its ellipses imply; `python
+docs/papers/make_face_gear_2013.py`) and [the multi-pair spiral bevel
+paper](papers/spiral_bevel_multipair.md) (pairs in contact, contact ratio, patch, bearing and TE
+against the load; `python docs/papers/make_spiral_bevel_multipair.py`).
+
 ## Summary
 
 """

@@ -20,7 +20,11 @@ Files written to the output folder (each one atomically: complete or absent):
   ``cycle.contact_ratio_unloaded`` (the interval over the angular pitch),
   ``cycle.path_length_mm`` (on the gear flank), ``cycle.path_length_in_space_mm``,
   ``cycle.path_ends`` (what ends it: ``"gear:tip"``, ``"pinion:tip"``, ``"transfer"``, …),
-  ``cycle.path_pinion_angles_deg``. Keys other tools rely on:
+  ``cycle.path_pinion_angles_deg``. The unloaded contact ellipses (every fidelity,
+  :mod:`fegear.tca.ellipse`): ``positions[i].contact_ellipse`` (the TCA's pair in contact: its
+  principal relative curvatures and directions, Litvin's ellipse for the paint thickness, the
+  Hertz ellipse of that pair carrying the whole load; null without contact) and
+  ``cycle.contact_ellipses`` (their ranges over the cycle). Keys other tools rely on:
   ``cycle.te_pp_unloaded_arcsec``, ``cycle.te_pp_loaded_arcsec``,
   ``cycle.contact_ratio_loaded``, ``cycle.p_max_MPa``, ``positions[i].pinion_angle_deg``,
   ``positions[i].te_loaded_arcsec``, ``positions[i].pairs[j].load_share``,
@@ -91,6 +95,7 @@ from fegear.output.flank_view import (
     pattern_centre,
     write_flank_vtp,
 )
+from fegear.output.pattern_plot import plot_loaded_pattern, plot_unloaded_pattern
 from fegear.output.records import solver_record, versions
 from fegear.pipeline.run import GearRun, report
 from fegear.store.files import atomic_write, write_json
@@ -228,6 +233,7 @@ def _fe_positions(run: GearRun) -> list[dict[str, Any]]:
                 },
                 "warnings": list(p.warnings),
                 "members": [_member_stress_row(mf, i) for mf in run.members],
+                "contact_ellipse": _ellipse_row(run, i),
             }
         )
     return rows
@@ -356,9 +362,27 @@ def _tca_positions(run: GearRun) -> list[dict[str, Any]]:
                 "te_loaded_arcsec": None,
                 "has_contact": bool(p.has_contact),
                 "pairs": pairs,
+                "contact_ellipse": _ellipse_row(run, i),
             }
         )
     return rows
+
+
+def _ellipse_row(run: GearRun, i: int) -> dict[str, Any] | None:
+    from fegear.tca.ellipse import record
+
+    return record(run.ellipses[i]) if i < len(run.ellipses) else None
+
+
+def _ellipse_cycle(run: GearRun) -> dict[str, Any]:
+    from fegear.tca import TCAOptions
+    from fegear.tca.ellipse import cycle_record
+
+    delta = next((e.delta_mm for e in run.ellipses if e is not None), TCAOptions().paint_mm)
+    doc = cycle_record(run.ellipses, delta, run.case.torque2_Nmm / run.case.ratio / 1000.0)
+    if not run.ellipses:
+        doc["reason"] = "not computed for this run"
+    return doc
 
 
 def gear_summary(
@@ -440,6 +464,7 @@ def gear_summary(
             "max_penetration_mm": max((s.max_penetration for s in sols), default=0.0),
             **_root_stress_cycle(run),
             **checks,
+            "contact_ellipses": _ellipse_cycle(run),
         }
         if c.zone is not None:
             # What the sectors modelled: their teeth, the pairs with a fine zone and the
@@ -480,6 +505,7 @@ def gear_summary(
             "positions_without_contact": int(np.sum(~r.has_contact)),
             "paint_thickness_mm": r.paint_mm,
             **checks,
+            "contact_ellipses": _ellipse_cycle(run),
         }
         doc["positions"] = _tca_positions(run)
         doc["timings_s"] = dict(run.seconds)
@@ -792,135 +818,13 @@ def _plot_root_stress(out: Path, run: GearRun) -> Path:
     return _save(fig, out / "root_stress.png")
 
 
-def _flank_bounds(run: GearRun):
-    m, side = run.pair.pinion, run.assembly.side1
-    try:
-        return m.boundaries(side)
-    except TypeError:
-        return m.boundaries()
-
-
-def _plot_pattern(out: Path, run: GearRun) -> Path:
-    """Union of the loaded cells on the pinion flank (tooth-local ``(u, v)``), coloured by the
-    largest pressure each point saw over the cycle; dots: force centroids (loaded path)."""
-    plt = _plt()
-    b = _flank_bounds(run)
-    nu, nv = 240, 240
-    us = np.linspace(b.u_fillet, b.u_tip, nu)
-    vs = np.linspace(b.v_start, b.v_end, nv)
-    P = np.zeros((nu, nv))
-    path = []
-    for pos in run.cycle.positions:
-        if not pos.cells:  # the hertz fidelity has no contact grid
-            continue
-        for c, p, q in zip(pos.cells, pos.pressure, pos.pairs, strict=True):
-            if q.force_N <= 0:
-                continue
-            _paint_cells(P, us, vs, c, p)
-            w = p * c.area
-            path.append((w @ c.uv) / w.sum())
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    Pm = np.ma.masked_where(P <= 0, P)
-    # Edge contacts carry singular, grid-dependent peaks: the colour scale ends at the largest
-    # pressure of the pairs away from the edges (when there are some), the rest is "above".
-    inner = [q.p_max_MPa for p in run.cycle.positions for q in p.pairs if not q.edge_contact]
-    vmax = max(inner) if inner and max(inner) > 0 else None
-    clipped = vmax is not None and float(P.max()) > vmax
-    im = ax.pcolormesh(vs, us, Pm, cmap="inferno", shading="nearest", vmax=vmax)
-    if path:
-        pa = np.array(path)
-        ax.plot(pa[:, 1], pa[:, 0], "c.", ms=4, label="force centroids")
-        ax.legend(fontsize=8, loc="upper right")
-    ax.add_patch(
-        _plt().Rectangle(
-            (b.v_start, b.u_fillet),
-            b.v_end - b.v_start,
-            b.u_tip - b.u_fillet,
-            fill=False,
-            ec="gray",
-            lw=1,
-        )  # fmt: skip
-    )
-    ax.set_xlim(b.v_start, b.v_end)
-    ax.set_ylim(b.u_fillet, b.u_tip)
-    ax.set_xlabel(getattr(b, "v_name", "v"))
-    ax.set_ylabel(getattr(b, "u_name", "u"))
-    ax.set_title(f"{_title(run)}\nloaded bearing pattern on the pinion flank", fontsize=9)
-    label = "max pressure over the cycle (MPa)"
-    if clipped:
-        label += f"\n(edge contacts up to {float(P.max()):.0f} MPa shown at the top colour)"
-    fig.colorbar(im, ax=ax, label=label, extend="max" if clipped else "neither")
-    return _save(fig, out / "bearing_pattern.png")
-
-
-def _paint_cells(P: np.ndarray, us: np.ndarray, vs: np.ndarray, c, p: np.ndarray) -> None:
-    """Raise the pixels ``P[(us, vs)]`` that the loaded cells of ``c`` cover to their pressure.
-
-    The cells form a grid in their own axes (turned against ``(u, v)`` by the ``hybrid``
-    refinement): the affine map from the cells' intrinsic coordinates to ``(u, v)`` is fitted
-    on the cell centres, every pixel is taken back to cell coordinates and coloured by the
-    nearest cell when it lies within that cell (normalised distance below one half-diagonal).
-    """
-    from scipy.spatial import cKDTree
-
-    load = p > 0
-    if not load.any():
-        return
-    X = np.c_[c.local, np.ones(c.n)]
-    B, _, rank, _ = np.linalg.lstsq(X, c.uv, rcond=None)  # uv ≈ [local, 1] B
-    if rank < 3 or abs(np.linalg.det(B[:2])) < 1e-12 * np.abs(B[:2]).max() ** 2:
-        # A single row or column of cells (grid axes along u, v): boxes from the spacings.
-        du = _spacing(c.uv[:, 0], float(c.cell_mm[0]))
-        dv = _spacing(c.uv[:, 1], float(c.cell_mm[1]))
-        for (u, v), pv in zip(c.uv[load], p[load], strict=True):
-            iu = (us >= u - du / 2) & (us <= u + du / 2)
-            iv = (vs >= v - dv / 2) & (vs <= v + dv / 2)
-            P[np.ix_(iu, iv)] = np.maximum(P[np.ix_(iu, iv)], pv)
-        return
-    box = (c.uv[load].min(0), c.uv[load].max(0))
-    pad = np.abs(B[:2]).T @ c.cell_mm
-    iu = np.flatnonzero((us >= box[0][0] - pad[0]) & (us <= box[1][0] + pad[0]))
-    iv = np.flatnonzero((vs >= box[0][1] - pad[1]) & (vs <= box[1][1] + pad[1]))
-    if iu.size == 0 or iv.size == 0:
-        return
-    UU, VV = np.meshgrid(us[iu], vs[iv], indexing="ij")
-    uv = np.stack([UU.ravel(), VV.ravel()], -1)
-    loc = np.linalg.solve(B[:2].T, (uv - B[2]).T).T  # pixel -> cell coordinates
-    scale = np.asarray(c.cell_mm, dtype=float)
-    d, j = cKDTree(c.local[load] / scale).query(loc / scale)
-    hit = d <= 0.75
-    vals = np.zeros(uv.shape[0])
-    vals[hit] = p[load][j[hit]]
-    blk = P[np.ix_(iu, iv)]
-    P[np.ix_(iu, iv)] = np.maximum(blk, vals.reshape(UU.shape))
-
-
-def _spacing(x: np.ndarray, cell_mm: float) -> float:
-    """Cell size along one flank coordinate: the spacing of the cell centres, or the cell size
-    in mm when the cells form a single row (the pinion flank coordinates of the involute
-    family, which carries the fe fidelity, are mm)."""
-    d = np.diff(np.unique(x))
-    d = d[d > 1e-9 * cell_mm]
-    return float(d.min()) if d.size else cell_mm
-
-
 def _tca_plots(out: Path, run: GearRun) -> list[Path]:
-    from fegear.tca.plots import plot_pattern, plot_te
+    from fegear.tca.plots import plot_te
 
     r, name = run.tca, run.case.name
     paths = [atomic_write(out / "te.png", lambda q: plot_te({name: r}, q,
                           title=f"{name}: unloaded TE (TCA)"))]  # fmt: skip
-    paths.append(
-        atomic_write(
-            out / "bearing_pattern.png",
-            lambda q: plot_pattern(
-                r,
-                q,
-                _flank_bounds(run),
-                title=f"{name}: unloaded bearing pattern on the pinion flank",
-            ),
-        )  # fmt: skip
-    )
+    paths.append(plot_unloaded_pattern(out, run))
     return paths
 
 
@@ -936,7 +840,7 @@ def write_gear_outputs(out: Path, run: GearRun, views: FlankViews | None = None)
     if run.cycle is not None:
         paths += _write_vtk(out, run, views)
         paths += [_plot_te(out, run), _plot_load_share(out, run), _plot_p_max(out, run),
-                  _plot_pattern(out, run)]  # fmt: skip
+                  plot_loaded_pattern(out, run)]  # fmt: skip
         if run.members and any(mf.root for mf in run.members):
             paths.append(_plot_root_stress(out, run))
     else:

@@ -356,6 +356,10 @@ class GearRun:
     cache
         The artefact-cache lookups of the run (:class:`fegear.store.cache.CacheUse`: what was
         read, what was built), or None.
+    ellipses
+        Per position the contact ellipses of the unloaded TCA
+        (:class:`fegear.tca.ellipse.EllipseAt`, None without contact; Hertz at the case's load
+        on one pair).
     """
 
     case: GearCase
@@ -367,6 +371,7 @@ class GearRun:
     seconds: dict[str, float] = field(default_factory=dict)
     engagement: Engagement | None = None
     cache: Any = None
+    ellipses: tuple = ()
 
     @property
     def fidelity(self) -> str:
@@ -716,6 +721,14 @@ def run_gear_case(
     return replace(run, cache=used())
 
 
+def _ellipses(case: GearCase, tca, positions) -> tuple:
+    """The contact ellipses of the TCA positions at the case's load (:mod:`fegear.tca.ellipse`)."""
+    from fegear.tca.ellipse import ellipses
+
+    T1 = case.torque2_Nmm / case.ratio / 1000.0
+    return ellipses(positions, tca.asm.axis1(), T1, tca.opt.paint_mm, case.E_MPa, case.nu)
+
+
 def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> GearRun:
     from fegear.ltca import LTCAOptions, build_models, run_ltca
     from fegear.ltca.cycle import cycle_tca
@@ -744,10 +757,12 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         for w in eng.warnings:
             (notify or log.warning)(w)
         r = cycle_result(list(positions), opt.paint_mm, tca)
+        ell = _ellipses(case, tca, positions)
         seconds["tca"] = time.perf_counter() - t0
         return GearRun(
-            case=case, pair=pair, assembly=tca.asm, tca=r, seconds=seconds, engagement=eng
-        )
+            case=case, pair=pair, assembly=tca.asm, tca=r, seconds=seconds, engagement=eng,
+            ellipses=ell,
+        )  # fmt: skip
 
     opt = LTCAOptions(
         n_positions=case.n_positions,
@@ -763,6 +778,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
     t0 = time.perf_counter()
     tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
     eng = check_engagement(case, pair, tca, positions, clearance)  # before the FE work
+    ell = _ellipses(case, tca, positions)
     for w in eng.warnings:
         (notify or log.warning)(w)
     seconds["checks"] = time.perf_counter() - t0
@@ -784,7 +800,8 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
     seconds["positions"] = time.perf_counter() - t0
     models = cycle.models  # those of the grown zone if the load made it grow
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
-    run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng)
+    run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng,
+                  ellipses=ell)  # fmt: skip
     if not fidelity_of(case.fidelity).cells:  # no cell loads: no displacement fields
         return run
     t0 = time.perf_counter()
@@ -801,6 +818,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         members=members,
         seconds=seconds,
         engagement=eng,
+        ellipses=ell,
     )
 
 

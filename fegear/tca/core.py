@@ -28,9 +28,9 @@ from scipy.spatial import cKDTree
 
 from ..assembly import Assembly, tooth_transform
 from ..errors import InputError
-from ..geometry.surface import finite_difference_curvatures
 from ..geometry.transforms import apply_points, apply_vectors, compose, inverse
 from ..hertz import effective_modulus, hertz_point, paint_ellipse
+from .ellipse import contact_curvature, normal_force
 from .results import ContactEllipseAt, PositionResult, SeparationGrid
 from .solve import circle_hit, in_bounds, line_hit, wrap
 from .surfaces import FlankMap, flank_map
@@ -640,48 +640,19 @@ class TCA:
         return tuple(out)
 
     def _ellipse(self, phi1, ts, cp, uv1, uv2, X, n1) -> ContactEllipseAt:
+        """The ellipse at the contact point of pair ``cp`` (:mod:`.ellipse`)."""
         a = self.asm
-        a1, b1 = self.fm1.native(uv1[0], uv1[1])
-        a2, b2 = self.fm2.native(uv2[0], uv2[1])
-        K = []
-        for fm, (pa, pb), M in (
-            (
-                self.fm1,
-                (a1, b1),
-                compose(a.placement1(phi1), tooth_transform(a.n1, self.pairs[cp, 0])),
-            ),
-            (
-                self.fm2,
-                (a2, b2),
-                compose(
-                    a.placement2(a.ratio * phi1 - ts), tooth_transform(a.n2, self.pairs[cp, 1])
-                ),
-            ),
-        ):
-            nrm = fm.evaluate(pa, pb)[1]
-            h = (50 * fm.step[0], 50 * fm.step[1])
-            lo, hi = fm.native_box()
-            pa = float(np.clip(pa, lo[0] + h[0], hi[0] - h[0]))
-            pb = float(np.clip(pb, lo[1] + h[1], hi[1] - h[1]))
-            k, d = finite_difference_curvatures(
-                lambda x, y, fm=fm: fm.evaluate(x, y)[0], pa, pb, h, nrm
+        M1 = compose(a.placement1(phi1), tooth_transform(a.n1, self.pairs[cp, 0]))
+        M2 = compose(a.placement2(a.ratio * phi1 - ts), tooth_transform(a.n2, self.pairs[cp, 1]))
+        c = contact_curvature(self.fm1, self.fm2, M1, M2, uv1, uv2, n1)
+        A, B, major = c.A, c.B, c.major_axis
+        if c.line_contact:
+            return ContactEllipseAt(
+                max(A, 0.0), max(B, 0.0), major, 0.0, 0.0, None, 0.0, True, curvature=c
             )
-            d = apply_vectors(M, d)
-            K.append(k[0] * np.outer(d[0], d[0]) + k[1] * np.outer(d[1], d[1]))
-        e1 = np.cross(n1, [0.0, 0.0, 1.0]) if abs(n1[2]) < 0.9 else np.cross(n1, [1.0, 0.0, 0.0])
-        e1 /= np.linalg.norm(e1)
-        E = np.stack([e1, np.cross(n1, e1)], -1)
-        S = 0.5 * E.T @ (K[0] + K[1]) @ E
-        w, V = np.linalg.eigh(0.5 * (S + S.T))
-        A, B = float(w[0]), float(w[1])
-        major = E @ V[:, 0]
-        if not A > 1e-9 * max(B, 1e-300) or not B > 0:
-            return ContactEllipseAt(max(A, 0.0), max(B, 0.0), major, 0.0, 0.0, None, 0.0, True)
         pe = paint_ellipse(self.opt.paint_mm, A, B)
         hz, F = None, 0.0
         if self.opt.pinion_torque_Nm:
-            o1, e = a.axis1()
-            arm = abs(np.dot(np.cross(e, X - o1), n1))
-            F = 1e3 * self.opt.pinion_torque_Nm / arm
+            F = normal_force(self.opt.pinion_torque_Nm, X, n1, a.axis1())
             hz = hertz_point(F, A, B, self.Es)
-        return ContactEllipseAt(A, B, major, pe.a_mm, pe.b_mm, hz, F, False)
+        return ContactEllipseAt(A, B, major, pe.a_mm, pe.b_mm, hz, F, False, curvature=c)

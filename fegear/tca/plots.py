@@ -9,7 +9,15 @@ import numpy as np
 
 from .results import CycleResult
 
-__all__ = ["plot_te", "plot_paths", "plot_pattern", "plot_assembly_conventions", "flank_outline"]
+__all__ = [
+    "plot_te",
+    "plot_paths",
+    "plot_pattern",
+    "plot_assembly_conventions",
+    "flank_outline",
+    "draw_ellipses",
+    "axis_label",
+]
 
 
 def _plt():
@@ -113,20 +121,77 @@ def flank_outline(ax, bounds, labels: Sequence[str] = ("", "")) -> None:
     ax.set_ylabel(b.height_name or b.u_name)
 
 
-def plot_pattern(r: CycleResult, path: str | Path, bounds=None, title: str = "") -> Path:
-    """Unloaded bearing pattern on the pinion flank: cells within the paint thickness."""
+def axis_label(text: str, width: int = 42) -> str:
+    """An axis label wrapped to lines of at most ``width`` characters (a flank coordinate's
+    long name, e.g. the spiral bevel's working-height fraction, would run off the figure)."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) or text
+
+
+def draw_ellipses(
+    ax,
+    ellipses,
+    member: str = "pinion",
+    which: Sequence[str] = ("paint", "hertz"),
+    xy=None,
+    color: str = "tab:blue",
+    lw: float = 0.6,
+) -> int:
+    """Draw the contact ellipses of a TCA path (:func:`fegear.tca.ellipse.ellipses`) on a flank.
+
+    ``member``: whose flank coordinates; ``which``: ``"paint"`` (Litvin's instantaneous ellipse,
+    solid) and/or ``"hertz"`` (one pair carrying the whole load, dashed); ``xy(uv (n, 2)) ->
+    (x (n,), y (n,))`` the plot coordinates of flank coordinates (default ``(v, u)``). Returns the
+    number of outlines drawn (line contacts have none).
+    """
+    from .ellipse import outline
+
+    xy = xy or (lambda uv: (uv[:, 1], uv[:, 0]))
+    styles = {"paint": "-", "hertz": "--"}
+    n = 0
+    for e in ellipses:
+        if e is None:
+            continue
+        for w in which:
+            o = outline(e, member, w)
+            if o is None:
+                continue
+            x, y = xy(o)
+            ax.plot(x, y, styles[w], color=color, lw=lw)
+            n += 1
+    return n
+
+
+def plot_pattern(
+    r: CycleResult, path: str | Path, bounds=None, title: str = "", ellipses=None
+) -> Path:
+    """Unloaded bearing pattern on the pinion flank: cells within the paint thickness, the
+    contact path and, with ``ellipses`` (:func:`fegear.tca.ellipse.ellipses` of the positions),
+    at each contact point Litvin's instantaneous ellipse for the paint thickness (solid) and the
+    Hertz ellipse of one pair carrying the whole load (dashed), as a path of ellipses (the
+    contact area of Litvin's TCA)."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(7.5, 4.4))
     if r.pattern_pinion.size:
         V, U = np.meshgrid(r.grid_v, r.grid_u)
         ax.pcolormesh(V, U, r.pattern_pinion.astype(float), cmap="Greys", vmin=0, vmax=1.5)
     m = r.has_contact
     ax.plot(r.pinion_uv[m, 1], r.pinion_uv[m, 0], "r.-", ms=3, label="contact path")
+    if ellipses is not None and draw_ellipses(ax, ellipses, "pinion", ("paint",), lw=0.5):
+        ax.plot([], [], "-", color="tab:blue", lw=0.5,
+                label=f"ellipse, paint {1e3 * r.paint_mm:.2f} µm")  # fmt: skip
+        if draw_ellipses(ax, ellipses, "pinion", ("hertz",), color="tab:green", lw=0.5):
+            T1 = next(e.pinion_torque_Nm for e in ellipses if e is not None)
+            ax.plot([], [], "--", color="tab:green", lw=0.5,
+                    label=f"Hertz, one pair at {T1:.4g} N·m")  # fmt: skip
     if bounds is not None:
-        ax.set_xlabel(bounds.v_name)
-        ax.set_ylabel(bounds.u_name)
-    ax.set_title(title or f"unloaded bearing pattern (paint {1e3 * r.paint_mm:.2f} µm)")
-    ax.legend(fontsize=8)
+        ax.set_xlim(bounds.v_start, bounds.v_end)
+        ax.set_ylim(bounds.u_fillet, bounds.u_tip)
+        ax.set_xlabel(axis_label(bounds.v_name))
+        ax.set_ylabel(axis_label(bounds.u_name))
+    ax.set_title(title or f"unloaded bearing pattern (paint {1e3 * r.paint_mm:.2f} µm)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

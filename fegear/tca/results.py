@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..hertz import HertzPoint
+from .ellipse import ContactCurvature
 
 __all__ = [
     "SeparationGrid",
@@ -103,6 +104,10 @@ class ContactEllipseAt:
         Normal force used for ``hertz`` (pinion torque / moment arm of the normal), 0 if none.
     line_contact
         ``A <= 1e-9 B`` (conjugate line contact): no ellipse; semi-axes are 0.
+    curvature
+        The curvatures at the contact point (:class:`~fegear.tca.ellipse.ContactCurvature`:
+        both flanks', the relative ones, the normal, the flank tangents), from which
+        :func:`fegear.tca.ellipse.ellipses` derives the ellipses at any load.
     """
 
     A: float
@@ -113,6 +118,7 @@ class ContactEllipseAt:
     hertz: HertzPoint | None
     force_N: float
     line_contact: bool
+    curvature: ContactCurvature | None = None
 
 
 @dataclass(frozen=True)
@@ -250,7 +256,8 @@ class CycleResult:
 # ------------------------------------------------------------------ plain-data records
 #: The classes a record (:func:`to_record`) may hold, by name.
 _RECORD_CLASSES = {
-    c.__name__: c for c in (PositionResult, SeparationGrid, ContactEllipseAt, HertzPoint)
+    c.__name__: c
+    for c in (PositionResult, SeparationGrid, ContactEllipseAt, ContactCurvature, HertzPoint)
 }
 
 

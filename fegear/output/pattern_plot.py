@@ -1,0 +1,193 @@
+"""The bearing-pattern picture of a gear run, ``bearing_pattern.png`` (pinion flank).
+
+Loaded fidelities (:func:`plot_loaded_pattern`): the union of the loaded contact cells coloured
+by the largest pressure over the cycle, the force centroids, and the unloaded TCA path with the
+Hertz ellipse of one pair carrying the whole load at each contact point. Fidelity ``tca``
+(:func:`plot_unloaded_pattern`): the cells within the paint thickness, the path, and at each
+contact point Litvin's instantaneous ellipse for the paint thickness and the Hertz ellipse
+(:func:`fegear.tca.plots.plot_pattern`). The ellipses are those of ``summary.json``
+(``positions[i].contact_ellipse``, :mod:`fegear.tca.ellipse`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from fegear.pipeline.run import GearRun
+from fegear.store.files import atomic_write
+from fegear.tca.plots import axis_label, draw_ellipses
+
+__all__ = ["plot_loaded_pattern", "plot_unloaded_pattern"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: Path) -> Path:
+    plt = _plt()
+    fig.tight_layout()
+    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
+    plt.close(fig)
+    return p
+
+
+def _title(run: GearRun) -> str:
+    c = run.case
+    return f"{c.name}: T2 {c.torque2_Nmm / 1000:.0f} N·m, {c.fidelity} level {c.level}"
+
+
+def _unloaded_path(ax, run: GearRun, which: tuple[str, ...], color: str) -> None:
+    """The TCA contact points of the run's positions and their ellipses (pinion flank)."""
+    es = [e for e in run.ellipses if e is not None]
+    if not es:
+        return
+    uv = np.array([e.pinion_uv for e in es])
+    ax.plot(uv[:, 1], uv[:, 0], "+", color=color, ms=5, mew=0.8, label="unloaded contact points")
+    if draw_ellipses(ax, es, "pinion", which, color=color, lw=0.5):
+        T1 = es[0].pinion_torque_Nm
+        ax.plot([], [], "--", color=color, lw=0.5,
+                label=f"Hertz ellipses, one pair at T1 = {T1:.4g} N·m")  # fmt: skip
+
+
+def plot_unloaded_pattern(out: Path, run: GearRun) -> Path:
+    """``bearing_pattern.png`` of fidelity ``tca`` (:func:`fegear.tca.plots.plot_pattern` with
+    the run's ellipses)."""
+    from fegear.tca.plots import plot_pattern
+
+    name = run.case.name
+    return atomic_write(
+        out / "bearing_pattern.png",
+        lambda q: plot_pattern(
+            run.tca,
+            q,
+            _flank_bounds(run),
+            title=f"{name}: unloaded bearing pattern on the pinion flank",
+            ellipses=run.ellipses or None,
+        ),
+    )
+
+
+def _flank_bounds(run: GearRun):
+    m, side = run.pair.pinion, run.assembly.side1
+    try:
+        return m.boundaries(side)
+    except TypeError:
+        return m.boundaries()
+
+
+def plot_loaded_pattern(out: Path, run: GearRun) -> Path:
+    """``bearing_pattern.png`` of a loaded run: the union of the loaded cells on the pinion flank
+    (tooth-local ``(u, v)``), coloured by the largest pressure each point saw over the cycle;
+    dots: force centroids (the loaded path); over it the unloaded TCA path with, at each of its
+    contact points, the Hertz ellipse of one pair carrying the whole load (dashed,
+    :mod:`fegear.tca.ellipse`): where the loaded patches are shorter than those, the load is
+    shared or the patch runs into a flank edge."""
+    plt = _plt()
+    b = _flank_bounds(run)
+    nu, nv = 240, 240
+    us = np.linspace(b.u_fillet, b.u_tip, nu)
+    vs = np.linspace(b.v_start, b.v_end, nv)
+    P = np.zeros((nu, nv))
+    path = []
+    for pos in run.cycle.positions:
+        if not pos.cells:  # the hertz fidelity has no contact grid
+            continue
+        for c, p, q in zip(pos.cells, pos.pressure, pos.pairs, strict=True):
+            if q.force_N <= 0:
+                continue
+            _paint_cells(P, us, vs, c, p)
+            w = p * c.area
+            path.append((w @ c.uv) / w.sum())
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    Pm = np.ma.masked_where(P <= 0, P)
+    # Edge contacts carry singular, grid-dependent peaks: the colour scale ends at the largest
+    # pressure of the pairs away from the edges (when there are some), the rest is "above".
+    inner = [q.p_max_MPa for p in run.cycle.positions for q in p.pairs if not q.edge_contact]
+    vmax = max(inner) if inner and max(inner) > 0 else None
+    clipped = vmax is not None and float(P.max()) > vmax
+    im = ax.pcolormesh(vs, us, Pm, cmap="inferno", shading="nearest", vmax=vmax)
+    if path:
+        pa = np.array(path)
+        ax.plot(pa[:, 1], pa[:, 0], "c.", ms=4, label="force centroids")
+    _unloaded_path(ax, run, ("hertz",), "deepskyblue")
+    if path or run.ellipses:
+        ax.legend(fontsize=7, loc="upper right")
+    ax.add_patch(
+        _plt().Rectangle(
+            (b.v_start, b.u_fillet),
+            b.v_end - b.v_start,
+            b.u_tip - b.u_fillet,
+            fill=False,
+            ec="gray",
+            lw=1,
+        )  # fmt: skip
+    )
+    ax.set_xlim(b.v_start, b.v_end)
+    ax.set_ylim(b.u_fillet, b.u_tip)
+    ax.set_xlabel(axis_label(getattr(b, "v_name", "v")))
+    ax.set_ylabel(axis_label(getattr(b, "u_name", "u")))
+    ax.set_title(f"{_title(run)}\nloaded bearing pattern on the pinion flank", fontsize=9)
+    label = "max pressure over the cycle (MPa)"
+    if clipped:
+        label += f"\n(edge contacts up to {float(P.max()):.0f} MPa shown at the top colour)"
+    fig.colorbar(im, ax=ax, label=label, extend="max" if clipped else "neither")
+    return _save(fig, out / "bearing_pattern.png")
+
+
+def _paint_cells(P: np.ndarray, us: np.ndarray, vs: np.ndarray, c, p: np.ndarray) -> None:
+    """Raise the pixels ``P[(us, vs)]`` that the loaded cells of ``c`` cover to their pressure.
+
+    The cells form a grid in their own axes (turned against ``(u, v)`` by the ``hybrid``
+    refinement): the affine map from the cells' intrinsic coordinates to ``(u, v)`` is fitted
+    on the cell centres, every pixel is taken back to cell coordinates and coloured by the
+    nearest cell when it lies within that cell (normalised distance below one half-diagonal).
+    """
+    from scipy.spatial import cKDTree
+
+    load = p > 0
+    if not load.any():
+        return
+    X = np.c_[c.local, np.ones(c.n)]
+    B, _, rank, _ = np.linalg.lstsq(X, c.uv, rcond=None)  # uv ≈ [local, 1] B
+    if rank < 3 or abs(np.linalg.det(B[:2])) < 1e-12 * np.abs(B[:2]).max() ** 2:
+        # A single row or column of cells (grid axes along u, v): boxes from the spacings.
+        du = _spacing(c.uv[:, 0], float(c.cell_mm[0]))
+        dv = _spacing(c.uv[:, 1], float(c.cell_mm[1]))
+        for (u, v), pv in zip(c.uv[load], p[load], strict=True):
+            iu = (us >= u - du / 2) & (us <= u + du / 2)
+            iv = (vs >= v - dv / 2) & (vs <= v + dv / 2)
+            P[np.ix_(iu, iv)] = np.maximum(P[np.ix_(iu, iv)], pv)
+        return
+    box = (c.uv[load].min(0), c.uv[load].max(0))
+    pad = np.abs(B[:2]).T @ c.cell_mm
+    iu = np.flatnonzero((us >= box[0][0] - pad[0]) & (us <= box[1][0] + pad[0]))
+    iv = np.flatnonzero((vs >= box[0][1] - pad[1]) & (vs <= box[1][1] + pad[1]))
+    if iu.size == 0 or iv.size == 0:
+        return
+    UU, VV = np.meshgrid(us[iu], vs[iv], indexing="ij")
+    uv = np.stack([UU.ravel(), VV.ravel()], -1)
+    loc = np.linalg.solve(B[:2].T, (uv - B[2]).T).T  # pixel -> cell coordinates
+    scale = np.asarray(c.cell_mm, dtype=float)
+    d, j = cKDTree(c.local[load] / scale).query(loc / scale)
+    hit = d <= 0.75
+    vals = np.zeros(uv.shape[0])
+    vals[hit] = p[load][j[hit]]
+    blk = P[np.ix_(iu, iv)]
+    P[np.ix_(iu, iv)] = np.maximum(blk, vals.reshape(UU.shape))
+
+
+def _spacing(x: np.ndarray, cell_mm: float) -> float:
+    """Cell size along one flank coordinate: the spacing of the cell centres, or the cell size
+    in mm when the cells form a single row (the pinion flank coordinates of the involute
+    family, which carries the fe fidelity, are mm)."""
+    d = np.diff(np.unique(x))
+    d = d[d > 1e-9 * cell_mm]
+    return float(d.min()) if d.size else cell_mm
