@@ -10,7 +10,7 @@ Runs the cases (:mod:`fegear.validation.rows`): the Hertz scene at ``fe`` and ``
 unloaded TCA, the seed face gear at its three loads (``hybrid`` and ``hertz`` level 0), and the
 ISO 6336-3 root-stress rows of ``fegear.validation.iso6336_root.rows()`` when that exists, and the
 helical pairs of :mod:`fegear.validation.cylindrical_rows` (contact ratios, stiffness, line
-Hertz, KHβ under misalignment). It takes
+Hertz, KHβ under misalignment, root stress with Yβ). It takes
 tens of minutes on 2 cores with an empty cache (the page states the time it took). The rows are
 kept in ``docs/validation.json``: naming sections reruns only those and keeps the others' rows.
 """
@@ -71,6 +71,8 @@ def _part(name: str):
             return asdict(C.helical_hertz_run())
         if what == "khb":
             return asdict(C.khb_run())
+        if what == "root":
+            return asdict(C.root_run())
     raise SystemExit(f"unknown part {name!r}")
 
 
@@ -112,11 +114,13 @@ def measure(section: str) -> list[Row]:
         from fegear.validation import cylindrical_rows as C
 
         rows = [as_row(d) for d in _run_part("cyl:ratios")]
-        runs = [C.StiffnessRun(**_run_part(f"cyl:stiffness:{n}")) for n in ("helical_15",
-                                                                            "helical_25")]
+        runs = [
+            C.StiffnessRun(**_run_part(f"cyl:stiffness:{n}")) for n in ("helical_15", "helical_25")
+        ]
         rows += C.stiffness_rows(runs)
         rows += C.hertz_rows(C.HertzRun(**_run_part("cyl:hertz")))
         rows += C.khb_rows(C.KHBetaRun(**_run_part("cyl:khb")))
+        rows += C.root_rows(C.RootRun(**_run_part("cyl:root")))
         return rows
     raise SystemExit(f"unknown section {section!r}: one of {', '.join(SECTIONS)}")
 

@@ -45,3 +45,33 @@ def test_helical_khb_row():
     assert k.k_h_beta > k.k_h_beta_aligned + 0.1
     # beside ISO's uncoupled elastic-foundation estimate (no pass/fail reference): within 25 %
     assert k.k_h_beta == pytest.approx(k.iso, rel=0.25), (k.k_h_beta, k.iso)
+
+
+def test_iso_root_stress_of_a_spur_pair_is_the_spur_reference():
+    """With β = 0 the virtual gear is the gear and Yβ = 1: the helical σF0 is the spur one of
+    fegear.validation.iso6336_root (FZG type C with its real tips, the spur function's inputs
+    taken from the same members)."""
+    from fegear.validation.iso6336_root import nominal_root_stress, root_factors
+
+    sigma, factors, yb, eb = C.iso_root_stress("fzg_type_c")
+    assert yb == 1.0 and eb == 0.0
+    case = C.pair_case("fzg_type_c")
+    p, g, asm = C._members(case)
+    from fegear.tca.contact_lines import iso_contact_ratios
+
+    ea = iso_contact_ratios(p, g, asm)[0]
+    f = root_factors(16, 4.5, 20.0, 0.1817, 1.25 * 4.5, 0.38 * 4.5, p.r_a, ea)
+    ref = nominal_root_stress(case.torque2_Nmm / g.r_p, 14.0, 4.5, f)
+    assert sigma["pinion"] == pytest.approx(ref, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_helical_root_stress_rows():
+    rr = C.root_run()
+    for r in C.root_rows(rr):
+        # ISO's YF, YS and Yβ are approximations: ±15 %
+        assert r.ratio(r.values[0]) == pytest.approx(1.0, abs=0.15), (
+            r.key,
+            r.values[0].value,
+            r.reference,
+        )

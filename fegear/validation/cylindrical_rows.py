@@ -24,6 +24,10 @@ curvature across the contact line; ISO 6336-2's ``Z_H`` has the same ``\cos β_b
 share of a helical pair's line is not a closed form); the reference is the pressure Hertz
 gives for it.
 
+*Root stress* — the largest maximum principal stress in a tension fillet over a loaded cycle
+(the stress sectors with refined fillets) against ISO 6336-3 method B's σF0 of the virtual spur
+gears with the helix factor Yβ (:func:`iso_root_stress`).
+
 *Face load factor of a misaligned pair* — the unmodified helical pair under an out-of-plane axis
 deviation ``f_Σβ`` whose mesh misalignment along the line of action is
 ``F_βx = f_Σβ \cos α_{wt}`` over the face, beside ISO 6336-1:2006 §7.6 (method C):
@@ -52,13 +56,17 @@ __all__ = [
     "PAIRS",
     "HertzRun",
     "KHBetaRun",
+    "RootRun",
     "StiffnessRun",
     "contact_ratio_rows",
     "helical_hertz_run",
     "hertz_rows",
+    "iso_root_stress",
     "khb_rows",
     "khb_run",
     "pair_case",
+    "root_rows",
+    "root_run",
     "stiffness_rows",
     "stiffness_run",
 ]
@@ -382,3 +390,106 @@ def khb_rows(k: KHBetaRun) -> list[Row]:
         command=COMMAND,
         test=f"{TESTS}::test_helical_khb_row",
     )]  # fmt: skip
+
+
+# --------------------------------------------------------------------------- root stress
+@dataclass(frozen=True)
+class RootRun:
+    """Largest tooth-root tension of each member over a loaded cycle and ISO 6336-3's σF0.
+
+    Attributes
+    ----------
+    fe_MPa, iso_MPa
+        ``{"pinion": …, "gear": …}``: fegear's largest maximum principal stress in a tension
+        fillet over the cycle, and ISO 6336-3 method B σF0 with Yβ.
+    factors
+        ``{member: (z_n, Y_F, Y_S)}`` of the virtual spur gears; ``y_beta`` Yβ.
+    """
+
+    name: str
+    n_positions: int
+    fe_MPa: dict
+    iso_MPa: dict
+    factors: dict
+    y_beta: float
+    eps_beta: float
+    fillet_mm: dict
+    seconds: float
+
+
+def iso_root_stress(name: str) -> tuple[dict, dict, float, float]:
+    r"""ISO 6336-3:2006 method B σF0 of both members of :data:`PAIRS` ``[name]``: the factors of
+    the virtual spur gear in the normal section (§5: ``z_n = z/(\cos^2β_b \cos β)``,
+    ``d_{an} = d_n + d_a − d``, ``ε_{αn} = ε_α/\cos^2β_b``;
+    :func:`fegear.validation.iso6336_root.root_factors`), ``Y_β = 1 − ε_β β/120°`` (``ε_β``,
+    ``β`` capped at 1 and 30°) and ``F_t = 2 T/d`` at the reference circle:
+    ``σ_{F0} = F_t/(b m_n) Y_F Y_S Y_β``. Returns ``(σF0, (z_n, Y_F, Y_S), Y_β, ε_β)``."""
+    from fegear.tca.contact_lines import iso_contact_ratios
+    from fegear.validation.iso6336_root import nominal_root_stress, root_factors
+
+    case = pair_case(name)
+    p, g, asm = _members(case)
+    ea, eb, _ = iso_contact_ratios(p, g, asm)
+    d = p.design
+    beta = abs(math.radians(d.helix_angle_deg))
+    cbb2 = math.cos(p.beta_b) ** 2
+    y_beta = 1.0 - min(eb, 1.0) * min(math.degrees(beta), 30.0) / 120.0
+    b = min(p.design.face_width_mm, g.design.face_width_mm)
+    ft = case.torque2_Nmm / g.r_p
+    sigma, factors = {}, {}
+    for who, m in (("pinion", p), ("gear", g)):
+        md = m.design
+        zn = md.n_teeth / (cbb2 * math.cos(beta))
+        dn = md.module_mm * zn
+        ran = 0.5 * (dn + 2 * m.r_a - 2 * m.r_p)
+        f = root_factors(zn, md.module_mm, md.pressure_angle_deg, md.profile_shift,
+                         md.dedendum_coeff * md.module_mm,
+                         md.rack_tip_radius_coeff * md.module_mm, ran, ea / cbb2)  # fmt: skip
+        sigma[who] = nominal_root_stress(ft, b, md.module_mm, f, y_beta)
+        factors[who] = (zn, f.YF, f.YS)
+    return sigma, factors, y_beta, eb
+
+
+def root_run(name: str = "helical_15", n_positions: int = 16) -> RootRun:
+    """fegear's root stress over a cycle (``hybrid`` level 0, the stress sectors with refined
+    fillets: :func:`fegear.pipeline.run.displacements`) beside :func:`iso_root_stress`. The
+    FE value is the largest over the positions and the loaded teeth: ISO's σF0 is the nominal
+    stress of the most unfavourable load position, which a helical tooth meets somewhere in the
+    cycle; ``n_positions`` samples it."""
+    from fegear.api import run
+
+    t0 = time.perf_counter()
+    r = run(pair_case(name, n_positions).replace(root_stress=True))
+    dt = time.perf_counter() - t0
+    fe, fil = {}, {}
+    for mf in r.run.members:
+        vals = [np.nanmax(mf.root_series(t)) for t in mf.root_teeth]
+        fe[mf.name] = float(np.nanmax(vals))
+        fil[mf.name] = float(mf.fillet_mm)
+    iso, factors, yb, eb = iso_root_stress(name)
+    return RootRun(name, n_positions, fe, iso, factors, yb, eb, fil, dt)
+
+
+def root_rows(rr: RootRun) -> list[Row]:
+    """ISO 6336-3 σF0 with Yβ against fegear's largest root tension, per member."""
+    rows = []
+    for who in ("pinion", "gear"):
+        zn, yf, ys = rr.factors[who]
+        rows.append(Row(
+            key=f"{rr.name}_root_stress_{who}",
+            check=f"{PAIRS[rr.name][2]}, {PAIRS[rr.name][1]:g} N·m: {who} root stress",
+            quantity=f"{who} σF, largest max principal stress in a tension fillet over the "
+            "cycle (MPa)",
+            reference=rr.iso_MPa[who],
+            reference_text=f"ISO 6336-3 method B σF0 = Ft/(b m_n) YF YS Yβ of the virtual spur "
+            f"gear z_n {zn:.2f}: YF {yf:.3f}, YS {ys:.3f}, Yβ = 1 − ε_β β/120° = {rr.y_beta:.4f} "
+            f"(ε_β {rr.eps_beta:.3f})",
+            values=(Value("hybrid", 0, rr.fe_MPa[who], seconds=rr.seconds,
+                          note=f"{rr.n_positions} positions; fillet elements "
+                          f"{rr.fillet_mm[who]:.3g} mm"),),
+            tolerance="±15 % (ISO's form and stress-correction factors and Yβ are "
+            "approximations; the FE maximum is sampled at the cycle's positions)",
+            command=COMMAND,
+            test=f"{TESTS}::test_helical_root_stress_rows",
+        ))  # fmt: skip
+    return rows
