@@ -137,3 +137,23 @@ def test_integer_overlap_ratio_smooths_the_loaded_te():
     h1 = helical.summary["cycle"]["te_harmonics"]["loaded"]["amplitude_arcsec"][0]
     s1 = spur.summary["cycle"]["te_harmonics"]["loaded"]["amplitude_arcsec"][0]
     assert h1 < 0.25 * s1, (h1, s1)
+
+
+@pytest.mark.parametrize("name", ["fzg_type_c", "helical_crowned"])
+def test_cylindrical_case_smoke(tmp_path, name):
+    """Each cylindrical case as shipped (hybrid level 0), through the command line, at 5
+    positions: the sectors are those of the tests above (the crowning is not in the solid)."""
+    from fegear.cli import main
+
+    path = tmp_path / f"{name}.toml"
+    text = (REPO / "cases" / f"{name}.toml").read_text("utf-8")
+    path.write_text(text.replace("n_positions = 9", "n_positions = 5"), "utf-8")
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "-q"]) == 0
+    doc = json.loads((out / "summary.json").read_text())
+    c = doc["cycle"]
+    assert doc["fidelity"] == "hybrid" and c["max_equilibrium_residual"] < 1e-9
+    assert c["p_max_MPa"] > 0 and c["positions_without_contact"] == 0
+    load = doc["cylindrical"]["load"]
+    assert load["k_h_beta"] >= 1.0 and load["c_gamma_N_per_mm_um"] > 0
+    assert (out / "line_load.png").is_file()
