@@ -2,13 +2,15 @@
 
 Usage::
 
-    python docs/make_validation.py [hertz] [fzg] [bevel] [trend] [root]   # default: all
+    python docs/make_validation.py [hertz] [fzg] [bevel] [trend] [root] [cylindrical]  # all
     python docs/make_validation.py render      # rewrite the page from docs/validation.json
 
 Runs the cases (:mod:`fegear.validation.rows`): the Hertz scene at ``fe`` and ``hybrid`` levels
 0-5, the FZG pair at its pitch point (``hybrid`` 0-2, ``fe`` 0-3, ``hertz`` 0), the spiral bevel's
 unloaded TCA, the seed face gear at its three loads (``hybrid`` and ``hertz`` level 0), and the
-ISO 6336-3 root-stress rows of ``fegear.validation.iso6336_root.rows()`` when that exists. It takes
+ISO 6336-3 root-stress rows of ``fegear.validation.iso6336_root.rows()`` when that exists, and the
+helical pairs of :mod:`fegear.validation.cylindrical_rows` (contact ratios, stiffness, line
+Hertz, KHβ under misalignment, root stress with Yβ). It takes
 tens of minutes on 2 cores with an empty cache (the page states the time it took). The rows are
 kept in ``docs/validation.json``: naming sections reruns only those and keeps the others' rows.
 """
@@ -32,7 +34,7 @@ from fegear.validation import rows as V
 HERE = Path(__file__).resolve().parent
 PAGE = HERE / "validation.md"
 DATA = HERE / "validation.json"
-SECTIONS = ("hertz", "fzg", "bevel", "trend", "root")
+SECTIONS = ("hertz", "fzg", "bevel", "trend", "root", "cylindrical")
 #: (fidelity, level) of the FZG pitch-point runs.
 FZG_RUNS = (("hybrid", 0), ("hybrid", 1), ("hybrid", 2), ("fe", 0), ("fe", 1), ("fe", 2),
             ("fe", 3), ("hertz", 0))  # fmt: skip
@@ -57,6 +59,20 @@ def _part(name: str):
     if kind == "root":
         rows = V.root_stress_rows()
         return [asdict(r) for r in rows or [V.pending_root_stress_row()]]
+    if kind == "cyl":
+        from fegear.validation import cylindrical_rows as C
+
+        what = arg[0]
+        if what == "ratios":
+            return [asdict(r) for r in C.contact_ratio_rows()]
+        if what == "stiffness":
+            return asdict(C.stiffness_run(arg[1]))
+        if what == "hertz":
+            return asdict(C.helical_hertz_run())
+        if what == "khb":
+            return asdict(C.khb_run())
+        if what == "root":
+            return asdict(C.root_run())
     raise SystemExit(f"unknown part {name!r}")
 
 
@@ -94,6 +110,18 @@ def measure(section: str) -> list[Row]:
         return V.load_trend_rows(trends)
     if section == "root":
         return [as_row(d) for d in _run_part("root")]
+    if section == "cylindrical":
+        from fegear.validation import cylindrical_rows as C
+
+        rows = [as_row(d) for d in _run_part("cyl:ratios")]
+        runs = [
+            C.StiffnessRun(**_run_part(f"cyl:stiffness:{n}")) for n in ("helical_15", "helical_25")
+        ]
+        rows += C.stiffness_rows(runs)
+        rows += C.hertz_rows(C.HertzRun(**_run_part("cyl:hertz")))
+        rows += C.khb_rows(C.KHBetaRun(**_run_part("cyl:khb")))
+        rows += C.root_rows(C.RootRun(**_run_part("cyl:root")))
+        return rows
     raise SystemExit(f"unknown section {section!r}: one of {', '.join(SECTIONS)}")
 
 

@@ -208,7 +208,9 @@ def _about(point: ArrayLike, M: Array) -> Array:
     return compose(translation(p), M, translation(-p))
 
 
-def involute_assembly(pinion, gear, errors: InstallationErrors | None = None) -> Assembly:
+def involute_assembly(
+    pinion, gear, errors: InstallationErrors | None = None, face_offset_mm: float = 0.0
+) -> Assembly:
     """Parallel-axes placement of two external involute members (spur / helical).
 
     Pinion axis ``+z`` through the origin, turning about ``+z``; gear axis through
@@ -217,6 +219,8 @@ def involute_assembly(pinion, gear, errors: InstallationErrors | None = None) ->
     ``inv α_w = inv α_t + 2 tan α_n (x1 + x2)/(z1 + z2)`` (ISO 21771 eq. for a_w).
     Geometric phase: pinion tooth 0 on ``+x`` (towards the gear), gear tooth 0 at polar angle
     ``π − π/N2`` about the gear axis (its drive flank faces the space on ``−x``).
+    ``face_offset_mm``: design axial offset of the pinion's face centre from the gear's (along
+    ``+z``); the parallelism deviations are then given over the width where the faces overlap.
     """
     errors = errors or InstallationErrors()
     d1, d2 = pinion.design, gear.design
@@ -228,8 +232,11 @@ def involute_assembly(pinion, gear, errors: InstallationErrors | None = None) ->
     )
     aw = _inv_inverse(inv_w)
     a = (pinion.r_p + gear.r_p) * math.cos(at) / math.cos(aw)
-    b = min(d1.face_width_mm, d2.face_width_mm)
-    base1 = translation([0.0, 0.0, errors.dA1_mm])
+    b1, b2, off = d1.face_width_mm, d2.face_width_mm, float(face_offset_mm)
+    b = min(off + b1 / 2, b2 / 2) - max(off - b1 / 2, -b2 / 2) if off else min(b1, b2)
+    if b <= 0:
+        raise InputError("face_offset_mm", off, f"|offset| < {(b1 + b2) / 2:g} (faces overlap)")
+    base1 = translation([0.0, 0.0, errors.dA1_mm + off])
     tilt = compose(
         rot_y(math.atan2(errors.f_sigma_delta_mm, b)),
         rot_x(-math.atan2(errors.f_sigma_beta_mm, b)),
@@ -238,7 +245,7 @@ def involute_assembly(pinion, gear, errors: InstallationErrors | None = None) ->
     base2 = compose(_about(centre, tilt), translation(centre + [0.0, 0.0, errors.dA2_mm]))
 
     def nominal() -> Assembly:
-        return involute_assembly(pinion, gear)
+        return involute_assembly(pinion, gear, face_offset_mm=off)
 
     return Assembly(
         kind="parallel",

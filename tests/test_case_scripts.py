@@ -132,12 +132,30 @@ def check_spiral_bevel_vh(results, out):
         assert 4.0 < r.cycle.te_pp_unloaded_arcsec < 14.0, r.cycle.te_pp_unloaded_arcsec
 
 
+def check_helical_crowning_sweep(results, out):
+    def khb(f, c):
+        return results[(f, c)].summary["cylindrical"]["load"]["k_h_beta"]
+
+    fs = sorted({f for f, _ in results})
+    cs = sorted({c for _, c in results})
+    f0, f1, c0, c_mid, c1 = fs[0], fs[-1], cs[0], cs[1], cs[-1]
+    # measured at 9 positions (the script as shipped): f_Σβ = 0: KHβ 1.07 without crowning,
+    # 2.17 with 20 µm; f_Σβ = 0.02 mm: 2.31, 1.67 (5 µm), 2.27 (20 µm). At the test's 5
+    # positions: 1.16, 2.15; 2.16, 1.89, 2.31 (the cycle mean of fewer, coarser samples)
+    assert khb(f0, c1) > khb(f0, c0) + 0.5  # crowning concentrates the aligned pair's load
+    assert khb(f1, c0) > khb(f0, c0) + 0.5  # the misalignment loads one face end
+    # a moderate crowning answers the misalignment, a strong one makes its own peak
+    assert khb(f1, c_mid) < khb(f1, c0) - 0.15 and khb(f1, c_mid) < khb(f1, c1) - 0.15
+    assert (out / "crowning.png").read_bytes()[:8] == PNG
+
+
 CHECKS = {
     "face_gear_dE": check_face_gear_dE,
     "face_gear_dA1": check_face_gear_dA1,
     "face_gear_dA2": check_face_gear_dA2,
     "face_gear_dgamma": check_face_gear_dgamma,
     "spiral_bevel_vh": check_spiral_bevel_vh,
+    "helical_crowning_sweep": check_helical_crowning_sweep,
 }
 
 
@@ -193,3 +211,15 @@ def test_spiral_bevel_vh_script(tmp_path, capsys):
     _printed_table(capsys.readouterr().out, list(results))
     _pictures(tmp_path)
     check_spiral_bevel_vh(results, tmp_path)
+
+
+def test_helical_crowning_sweep_script(tmp_path, capsys):
+    """The crowning sweep on 3 crownings × 2 misalignments at 5 positions, loaded (KHβ needs the
+    load: ``hybrid`` level 0 whatever ``$FEGEAR_SCRIPT_FIDELITY`` says; the sectors are those of
+    the helical tests, cached, and every variant reads them: ~10 s each)."""
+    main = _main("helical_crowning_sweep")
+    results = main(fidelity="hybrid", out=str(tmp_path), crowning=(0.0, 0.005, 0.02),
+                   misalignment=(0.0, 0.02), n_positions=5)  # fmt: skip
+    out = capsys.readouterr().out
+    assert sum(ln.startswith("| 0.0") for ln in out.splitlines()) == 6
+    check_helical_crowning_sweep(results, tmp_path)

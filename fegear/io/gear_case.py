@@ -26,6 +26,7 @@ from typing import Any
 
 from fegear.assembly import InstallationErrors
 from fegear.errors import InputError
+from fegear.geometry.cylindrical import RELIEF_SHAPES
 from fegear.geometry.face_gear import FaceGearDesign
 from fegear.geometry.involute import InvoluteDesign
 from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
@@ -48,6 +49,7 @@ from fegear.options import ContactOptions
 
 __all__ = [
     "GEAR_KINDS",
+    "PARALLEL_KINDS",
     "DEFAULT_FIDELITY",
     "FIDELITIES",
     "UNLOADED",
@@ -60,7 +62,9 @@ __all__ = [
     "sections",
 ]
 
-GEAR_KINDS = ("face_gear", "spur", "spiral_bevel")
+GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel")
+#: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
+PARALLEL_KINDS = ("spur", "cylindrical")
 #: Fidelities of the gear pairs (DESIGN §9).
 #: The unloaded analysis (rigid TCA only); the others are the loaded fidelities of
 #: :data:`fegear.ltca.fidelity.FIDELITIES` (tests/test_architecture.py keeps the two in step).
@@ -88,6 +92,78 @@ _POS = Range(0, None, lo_open=True)
 _NONNEG = Range(0, None)
 _TEETH = Range(5, None)
 _DEG = "deg"
+
+_MOD = NUMBER_OR_PAIR
+_SHAPES = tuple(RELIEF_SHAPES)
+
+
+def _mod(name: str, doc: str, rng: Range | None = _NONNEG, default: Any = 0.0) -> Key:
+    return Key(name, _MOD, doc, default=default, range=rng)
+
+
+#: ``[pair]`` of ``kind = "cylindrical"``: spur and helical pairs with flank modifications
+#: (:mod:`fegear.geometry.cylindrical`; the modifications are transverse deviations along the
+#: line of action, positive = material removed).
+_CYLINDRICAL = Section(
+    "pair",
+    (
+        Key("teeth", INT_PAIR, "tooth numbers", True, range=_TEETH),
+        Key("module_mm", NUMBER, "normal module m_n, mm", True, range=_POS),
+        Key("pressure_angle_deg", NUMBER, "normal pressure angle α_n, deg", True,
+            range=Range(10, 35, unit=_DEG)),
+        Key("helix_angle_deg", NUMBER, "helix angle β at the reference circle, deg (0: spur)",
+            default=0.0, range=Range(0, 45, unit=_DEG)),
+        Key("hand", STRING, "hand of the pinion's helix (the gear's is the other)",
+            default="right", choices=("right", "left")),
+        Key("profile_shift", NUMBER_PAIR, "profile shift coefficients x", default=[0.0, 0.0],
+            range=Range(-1, 2)),
+        Key("tip_diameter_mm", NUMBER_PAIR, "tip diameters d_a, mm (default: "
+            "m_n (z/cos β + 2 h_a* + 2 x))", range=_POS),
+        Key("face_width_mm", NUMBER_OR_PAIR, "face width b, mm",
+            default=_design_default(InvoluteDesign, "face_width_mm"), range=_POS),
+        Key("face_offset_mm", NUMBER, "axial position of the pinion's face centre from the "
+            "gear's (along the axes), mm", default=0.0),
+        Key("addendum_coeff", NUMBER_OR_PAIR, "addendum h_a* / m_n (the tip when no "
+            "tip_diameter_mm)", default=_design_default(InvoluteDesign, "addendum_coeff"),
+            range=_POS),
+        Key("dedendum_coeff", NUMBER_OR_PAIR, "dedendum h_f* / m_n (the tool's addendum: the "
+            "root)", default=_design_default(InvoluteDesign, "dedendum_coeff"), range=_POS),
+        Key("tool_tip_radius_coeff", NUMBER_OR_PAIR, "tip radius of the generating rack "
+            "ρ_aP0* / m_n (generates the fillet)",
+            default=_design_default(InvoluteDesign, "rack_tip_radius_coeff"), range=_POS),
+        _mod("lead_crowning_mm", "lead crowning C_β (removed at both face ends), mm"),
+        _mod("helix_slope_mm", "helix slope deviation f_Hβ over the face width (positive: "
+             "removed towards +z), mm", rng=None),
+        _mod("end_relief_mm", "end relief C_e at both face ends, mm"),
+        _mod("end_relief_length_mm", "length of the end relief l_e from each face end, mm",
+             rng=_POS, default=None),
+        Key("end_relief_shape", STRING, "end relief along the face", default="linear",
+            choices=_SHAPES),
+        _mod("profile_crowning_mm", "profile crowning C_α (removed at the form circle and "
+             "the tip), mm"),
+        _mod("tip_relief_mm", "tip relief C_a at the tip circle, mm"),
+        _mod("tip_relief_start_diameter_mm", "diameter where the tip relief starts, mm "
+             "(default: 60 % of the way from the reference to the tip diameter)", rng=_POS,
+             default=None),
+        _mod("tip_relief_start_roll_deg", "roll angle where the tip relief starts, deg "
+             "(instead of a diameter)", rng=_POS, default=None),
+        Key("tip_relief_shape", STRING, "tip relief along the profile (roll length)",
+            default="linear", choices=_SHAPES),
+        _mod("root_relief_mm", "root relief C_f at the form circle, mm"),
+        _mod("root_relief_start_diameter_mm", "diameter where the root relief starts, mm "
+             "(default: 60 % of the way from the reference to the form diameter)", rng=_POS,
+             default=None),
+        _mod("root_relief_start_roll_deg", "roll angle where the root relief starts, deg "
+             "(instead of a diameter)", rng=_POS, default=None),
+        Key("root_relief_shape", STRING, "root relief along the profile (roll length)",
+            default="linear", choices=_SHAPES),
+    ),
+    "Spur and helical pairs with flank modifications: a number for both members or "
+    "[pinion, gear]. Modifications are deviations from the involute helicoid measured in the "
+    "transverse section along the line of action (ISO 21771, as on a profile or helix chart), "
+    "positive where material is removed.",
+    required=True,
+)  # fmt: skip
 
 #: ``[pair]`` by kind (design data; the geometry checks the rest: undercut, pointing).
 PAIR_SECTIONS: dict[str, Section] = {
@@ -219,9 +295,13 @@ PAIR_SECTIONS: dict[str, Section] = {
                 range=_NONNEG,
             ),
         ),
-        "Spur involute pair (validation): a number for both members or [pinion, gear].",
+        "Spur involute pair, its modifications on the generating rack (the FZG validation "
+        "pair): a number for both members or [pinion, gear]. Its keys are valid for "
+        '`kind = "cylindrical"` too, which adds the helix, tip diameters, the tool and the '
+        "flank modifications: change the kind to use them.",
         required=True,
     ),
+    "cylindrical": _CYLINDRICAL,
     "spiral_bevel": Section(
         "pair",
         (
@@ -285,7 +365,7 @@ PAIR_SECTIONS: dict[str, Section] = {
     ),
 }
 _INTERSECTING = "intersecting axes (face gear, spiral bevel)"
-_PARALLEL = "parallel axes (spur)"
+_PARALLEL = "parallel axes (spur, cylindrical)"
 #: ``[errors]`` by axis arrangement (sign conventions: :mod:`fegear.assembly`).
 ERROR_KEYS: dict[str, tuple[Key, ...]] = {
     "intersecting": (
@@ -448,7 +528,7 @@ def sections(kind: str) -> tuple[Section, ...]:
     """The sections of a gear case of ``kind`` (``[pair]`` and ``[errors]`` by kind)."""
     errors = Section(
         "errors",
-        ERROR_KEYS["parallel" if kind == "spur" else "intersecting"],
+        ERROR_KEYS["parallel" if kind in PARALLEL_KINDS else "intersecting"],
         "Installation errors, all 0 by default (sign conventions: fegear.assembly).",
     )
     return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL, CONTACT)
@@ -478,7 +558,7 @@ class GearCase:
     name
         Case name (``[case] name``, else the file stem).
     kind
-        ``"face_gear"``, ``"spur"`` or ``"spiral_bevel"``.
+        ``"face_gear"``, ``"spur"``, ``"cylindrical"`` or ``"spiral_bevel"``.
     pair
         The ``[pair]`` table with defaults filled in (case-file keys and units).
     torque2_Nmm
@@ -722,13 +802,13 @@ def _plain(value: Any) -> Any:
 def _tooth_numbers(kind: str, pair: dict[str, Any]) -> tuple[int, int]:
     if kind == "face_gear":
         return pair["n_pinion"], pair["n_face_gear"]
-    if kind == "spur":
+    if kind in PARALLEL_KINDS:
         return pair["teeth"][0], pair["teeth"][1]
     return pair["n_pinion"], pair["n_gear"]
 
 
 def _error_keys(kind: str) -> tuple[str, ...]:
-    return PAIR_ERRORS_PARALLEL if kind == "spur" else PAIR_ERRORS_INTERSECTING
+    return PAIR_ERRORS_PARALLEL if kind in PARALLEL_KINDS else PAIR_ERRORS_INTERSECTING
 
 
 def _check_pair(kind: str, p: dict[str, Any]) -> dict[str, Any]:

@@ -650,6 +650,11 @@ def sector_mesh(
     if not isinstance(n_teeth, int) or not 1 <= n_teeth <= member.n_teeth // 2:
         raise InputError("mesh.n_teeth", n_teeth, f"an integer in 1..{member.n_teeth // 2}")
     mesh_sizes(1.0, level)
+    # a member with flank modifications of some µm is meshed as its unmodified solid (optional
+    # capability ``mesh_member()``, fegear.geometry.cylindrical): the same mesh and compliance
+    # operator serve every modification; the gaps come from the exact modified surfaces
+    if hasattr(member, "mesh_member"):
+        member = member.mesh_member()
     fr = sector_frame(member, rim_modules)
     zone = tuple(default_zone(fr, n_teeth, side) if zone is None else zone)
     for z in zone:

@@ -85,6 +85,12 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from fegear.geometry.transforms import apply_points, apply_vectors
+from fegear.output.cylindrical_output import (
+    cylindrical_section,
+    is_cylindrical,
+    plot_line_load,
+    te_harmonics,
+)
 from fegear.output.flank_view import (
     TIME_UNIT,
     FlankFrame,
@@ -465,6 +471,7 @@ def gear_summary(
             **_root_stress_cycle(run),
             **checks,
             "contact_ellipses": _ellipse_cycle(run),
+            "te_harmonics": te_harmonics(c),
         }
         if c.zone is not None:
             # What the sectors modelled: their teeth, the pairs with a fine zone and the
@@ -510,6 +517,8 @@ def gear_summary(
         doc["positions"] = _tca_positions(run)
         doc["timings_s"] = dict(run.seconds)
         warnings = list(rep.warnings)
+    if is_cylindrical(run):
+        doc["cylindrical"] = cylindrical_section(run)
     doc["pattern"] = (
         {m: pc.as_dict() for m, pc in views.pattern.items()} if views is not None else None
     )
@@ -843,6 +852,8 @@ def write_gear_outputs(out: Path, run: GearRun, views: FlankViews | None = None)
                   plot_loaded_pattern(out, run)]  # fmt: skip
         if run.members and any(mf.root for mf in run.members):
             paths.append(_plot_root_stress(out, run))
+        if is_cylindrical(run):
+            paths.append(plot_line_load(out, run))
     else:
         paths += _tca_plots(out, run)
     files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]

@@ -3,8 +3,8 @@
 A gear family is a :class:`Family`: it turns the ``[pair]`` table of a validated
 :class:`~fegear.io.gear_case.GearCase` into the generated members (objects of the
 :class:`~fegear.geometry.surface.GeneratedMember` protocol) and assembles them with installation
-errors. The pipeline reaches a family only through :data:`FAMILIES`, so a new family (hypoid,
-helical) is one more :class:`Family` here, its ``[pair]`` section in
+errors. The pipeline reaches a family only through :data:`FAMILIES`, so a new family (hypoid)
+is one more :class:`Family` here, its ``[pair]`` section in
 :mod:`fegear.io.gear_case` and its members in :mod:`fegear.geometry`; everything downstream of
 the pair (TCA, meshes, compliance, contact) works on the member protocol.
 """
@@ -183,6 +183,94 @@ class SpurFamily:
         return involute_assembly(pair.pinion, pair.gear, errors)
 
 
+class CylindricalFamily:
+    """Spur and helical pairs with flank modifications (:mod:`fegear.geometry.cylindrical`);
+    the ``[pair]`` keys of ``kind = "cylindrical"`` (:mod:`fegear.io.gear_case`)."""
+
+    kind = "cylindrical"
+    _fields = {
+        "n_teeth": "teeth",
+        "tip_radius_mm": "tip_diameter_mm",
+        "rack_tip_radius_coeff": "tool_tip_radius_coeff",
+        "helix_angle_deg": "helix_angle_deg",
+    }
+    #: per-member ``[pair]`` keys of the modifications (FlankModifications fields)
+    _MODS = (
+        "lead_crowning_mm", "helix_slope_mm", "end_relief_mm", "end_relief_length_mm",
+        "profile_crowning_mm", "tip_relief_mm", "tip_relief_start_diameter_mm",
+        "tip_relief_start_roll_deg", "root_relief_mm", "root_relief_start_diameter_mm",
+        "root_relief_start_roll_deg",
+    )  # fmt: skip
+    _SHAPES = ("end_relief_shape", "tip_relief_shape", "root_relief_shape")
+
+    @staticmethod
+    def _value(pair: dict, key: str, i: int) -> Any:
+        """Member ``i``'s value of a ``[pair]`` key (its declared default when absent)."""
+        v = PAIR_SECTIONS["cylindrical"].value(pair, key)
+        return v[i] if isinstance(v, list) else v
+
+    def build(self, case: GearCase) -> GearPair:
+        from fegear.geometry import InvoluteDesign
+        from fegear.geometry.cylindrical import (
+            CylindricalMember,
+            FlankModifications,
+            signed_helix_deg,
+        )
+
+        p = case.pair
+        value = self._value
+        beta = float(value(p, "helix_angle_deg", 0))
+        hand = value(p, "hand", 0)
+        members = []
+        for i, name in enumerate(("pinion", "gear")):
+            # the gear's helix has the other hand (external pair)
+            own = hand if i == 0 else {"right": "left", "left": "right"}[hand]
+            tip = value(p, "tip_diameter_mm", i)
+            try:
+                d = InvoluteDesign(
+                    n_teeth=int(p["teeth"][i]),
+                    module_mm=float(p["module_mm"]),
+                    pressure_angle_deg=float(p["pressure_angle_deg"]),
+                    helix_angle_deg=signed_helix_deg(beta, own) if beta else 0.0,
+                    profile_shift=float(value(p, "profile_shift", i)),
+                    face_width_mm=float(value(p, "face_width_mm", i)),
+                    addendum_coeff=float(value(p, "addendum_coeff", i)),
+                    dedendum_coeff=float(value(p, "dedendum_coeff", i)),
+                    rack_tip_radius_coeff=float(value(p, "tool_tip_radius_coeff", i)),
+                    tip_radius_mm=None if tip is None else 0.5 * float(tip),
+                )
+                kw = {k: value(p, k, i) for k in self._MODS}
+                kw = {k: (None if v is None else float(v)) for k, v in kw.items()}
+                kw.update({k: value(p, k, i) for k in self._SHAPES})
+                members.append(CylindricalMember(d, name, FlankModifications(**kw)))
+            except InputError as exc:
+                if exc.field == "tip_radius_mm":  # a radius in the geometry, a diameter here
+                    exc = _as_diameter(exc)
+                raise _renamed(exc, i, self._fields, case) from exc
+        off = float(PAIR_SECTIONS["cylindrical"].value(p, "face_offset_mm"))
+        try:
+            asm = involute_assembly(*members, case.errors, face_offset_mm=off)
+        except InputError as exc:
+            raise _renamed(exc, None, self._fields, case) from exc
+        return GearPair(members[0], members[1], asm)
+
+    def assemble(self, case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:
+        off = float(PAIR_SECTIONS["cylindrical"].value(case.pair, "face_offset_mm"))
+        return involute_assembly(pair.pinion, pair.gear, errors, face_offset_mm=off)
+
+
+def _as_diameter(exc: InputError) -> InputError:
+    """The geometry's tip-radius error in diameters (the case file gives tip diameters)."""
+    import re
+
+    def twice(m: re.Match) -> str:
+        return f"{2 * float(m.group(0)):.4f}"
+
+    allowed = re.sub(r"\d+\.\d+", twice, exc.allowed)
+    value = 2 * exc.value if isinstance(exc.value, (int, float)) else exc.value
+    return type(exc)(exc.field, value, allowed.replace("radius", "diameter"), exc.detail)
+
+
 class SpiralBevelFamily:
     """Face-milled spiral bevel pair, synthesized from its blank data (machine settings for a
     predesigned parabolic transmission error). The synthesis (10-20 s) is kept per process and
@@ -254,7 +342,7 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
 
 #: The gear families, by ``[case] kind``.
 FAMILIES: dict[str, Family] = {
-    f.kind: f for f in (FaceGearFamily(), SpurFamily(), SpiralBevelFamily())
+    f.kind: f for f in (FaceGearFamily(), SpurFamily(), CylindricalFamily(), SpiralBevelFamily())
 }
 
 

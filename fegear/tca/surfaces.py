@@ -12,6 +12,9 @@ coordinates* ``(u, v)`` (profile × face, with :class:`~fegear.geometry.surface.
   native ``(ε = tan α_y, z)``; the rack profile parameter ``u`` is affine in ``ε``
   (``√(r² − r_b²) = r sin α_t + η / sin α_t``, ``η`` the rack height; Litvin & Fuentes 2004
   ch. 10). Agrees with the generated surface to ~1e-12 mm (tested).
+- :class:`HelicoidMap`: the modified involute helicoid of a cylindrical member (spur or helical,
+  with flank modifications; :mod:`fegear.geometry.cylindrical`), closed form with analytic
+  tangents, native = flank coordinates ``(u, z)``; it is the member's own working flank.
 - :class:`SpiralBevelMap`: face-milled spiral bevel, native ``(s, θ)`` cutter parameters, ψ from
   the equation of meshing by Newton from a tabulated predictor
   (:class:`~fegear.geometry.spiral_bevel.NativeFlank`); analytic Jacobian; flank coordinates:
@@ -44,6 +47,7 @@ __all__ = [
     "FlankMap",
     "GenericFlankMap",
     "SpurInvoluteMap",
+    "HelicoidMap",
     "FaceGearMap",
     "SpiralBevelMap",
     "FAST_FLANK_MAPS",
@@ -170,6 +174,20 @@ class SpurInvoluteMap(FlankMap):
 
 
 @dataclass(frozen=True)
+class HelicoidMap(FlankMap):
+    """Modified involute helicoid of a cylindrical member (:mod:`fegear.geometry.cylindrical`),
+    closed form, continued past the working flank (the Newton solves step over its limits);
+    native = flank coordinates ``(u, z)``."""
+
+    def evaluate(self, a, b):
+        return self.member.helicoid(self.side, a, b)[:2]
+
+    def jacobian(self, a, b, p):
+        _, _, pu, pv = self.member.helicoid(self.side, a, b)
+        return pu, pv
+
+
+@dataclass(frozen=True)
 class FaceGearMap(FlankMap):
     """Closed-form face gear (γ = 90°); native ``(t, ψ)`` shaper roll and shaper angle."""
 
@@ -272,6 +290,8 @@ class SpiralBevelMap(FlankMap):
 
 FAST_FLANK_MAPS: dict[str, tuple[type[FlankMap], tuple[float, float]]] = {
     "spur_involute": (SpurInvoluteMap, (1e-7, 1e-5)),
+    # 50 steps (the ellipse's curvatures) = 1e-3 mm
+    "involute_helicoid": (HelicoidMap, (2e-5, 2e-5)),
     "face_gear_orthogonal": (FaceGearMap, (1e-7, 1e-8)),
     # steps of the finite-difference curvatures (ellipse): 50 steps = 0.01 mm, 1e-3 rad
     "spiral_bevel_native": (SpiralBevelMap, (2e-4, 2e-5)),
