@@ -85,6 +85,14 @@ HANDOVER_FRACTION = 2.0 / (48 * 8**3)
 #: machine; 4.3e-7 between one and two BLAS threads)
 LOADED_RTOL = 1e-4
 
+#: the TCA's contact ellipses: the principal curvatures are central second differences of the
+#: exact flanks (``fegear.tca.ellipse.contact_curvature``), accurate to 3e-3 of the relative
+#: curvature (its docstring: against a quadratic fit of the exact separation); between kernels
+#: they move within that (the face gear's gear flank, nearly flat: 1.9e-5 1/mm of 4.5e-3), and
+#: the axes, p0 and approach made from them with it. The orientations: 3e-3 rad
+ELLIPSE_RTOL = 3e-3
+ELLIPSE_ATOL = ELLIPSE_RTOL * B_MAX
+
 #: ``(path pattern, rtol, atol, reason)``: the first pattern matching a leaf's path decides
 TOLERANCES: list[tuple[re.Pattern[str], float, float, str]] = [
     (re.compile(p), rtol, atol, why)
@@ -103,6 +111,14 @@ TOLERANCES: list[tuple[re.Pattern[str], float, float, str]] = [
         (r"^\.cycle\.hertz_p0_max_MPa$", LOCATION_MM / LEVER_MIN_MM, 0.0,
          "Hertz at a point located to LOCATION_MM: its force arm moves by LOCATION_MM / "
          "LEVER_MIN_MM (the curvatures vary over the path's length, >= 8 mm, less)"),
+        (r"\.contact_ellipses?\.point_mm", 0.0, LOCATION_MM,
+         "the TCA's contact point, located to LOCATION_MM"),
+        (r"\.contact_ellipses?\.(normal|principal_directions)", 0.0, ELLIPSE_RTOL,
+         "unit vectors: the curvature tensor's directions, to ELLIPSE_RTOL rad"),
+        (r"\.contact_ellipses?\..*_deg\b", 0.0, math.degrees(ELLIPSE_RTOL),
+         "an orientation of the curvature tensor, to ELLIPSE_RTOL rad"),
+        (r"\.contact_ellipses?\.", ELLIPSE_RTOL, ELLIPSE_ATOL,
+         "finite-difference curvatures and what is made of them, to ELLIPSE_RTOL of B"),
         (r"^\.(positions\[\d+\]\.pairs\[\d+\]\.contact_point_mm|cycle\.path_|pattern\.)",
          0.0, LOCATION_MM,
          "the TCA's contact points, located to LOCATION_MM, and what is measured from them (the "
