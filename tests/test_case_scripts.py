@@ -159,7 +159,16 @@ CHECKS = {
 }
 
 
-@pytest.mark.parametrize("name", [n for n in CHECKS if n.startswith("face_gear")])
+# The four face-gear scripts differ only in the error they vary (they read the same meshes and
+# operators): face_gear_dgamma.py runs by default, the other three (about 30 s each) under -m slow.
+@pytest.mark.parametrize(
+    "name",
+    [
+        n if n == "face_gear_dgamma" else pytest.param(n, marks=pytest.mark.slow)
+        for n in CHECKS
+        if n.startswith("face_gear")
+    ],
+)
 def test_face_gear_script(name, tmp_path, capsys):
     """Each face-gear script: three runs of the seed face gear (the error-free one is shared
     through the cache), the table printed, the pictures written."""
@@ -170,6 +179,7 @@ def test_face_gear_script(name, tmp_path, capsys):
     CHECKS[name](results, tmp_path)
 
 
+@pytest.mark.slow  # the bevel's loaded V/H study: minutes of FE work
 def test_spiral_bevel_vh_script_on_dE(tmp_path, capsys):
     """The V/H script on ΔE alone at 5 positions (the machine-setting synthesis, ~15 s, once per
     process; the runs are those of the bevel smoke tests of tests/test_gear_cli.py, cached):
@@ -213,6 +223,7 @@ def test_spiral_bevel_vh_script(tmp_path, capsys):
     check_spiral_bevel_vh(results, tmp_path)
 
 
+@pytest.mark.slow  # a loaded crowning sweep: minutes of FE work
 def test_helical_crowning_sweep_script(tmp_path, capsys):
     """The crowning sweep on 3 crownings × 2 misalignments at 5 positions, loaded (KHβ needs the
     load: ``hybrid`` level 0 whatever ``$FEGEAR_SCRIPT_FIDELITY`` says; the sectors are those of

@@ -73,6 +73,7 @@ def seed_face_gear():
     return pair, opt, build_models(pair.pinion, pair.gear, pair.assembly, opt)
 
 
+@pytest.mark.slow  # the seed face gear's models and two loaded positions: minutes cold
 @pytest.mark.parametrize(
     ("case", "position", "expected"),
     [

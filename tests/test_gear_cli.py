@@ -370,6 +370,7 @@ def test_fzg_pngs_are_written(fzg_run):
 # --------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # a loaded fe cycle of the face gear: minutes
 def test_fe_says_plainly_that_its_cells_are_wider_than_the_patch(tmp_path, capsys):
     """The loaded analysis of the spiral bevel pair at ``fe`` level 0 (5 positions): it runs and
     balances the torque, but its 2.2 mm cells are wider than the 0.4-0.6 mm patch at every
@@ -397,7 +398,17 @@ def test_fe_says_plainly_that_its_cells_are_wider_than_the_patch(tmp_path, capsy
 BEVEL_CASES = sorted((REPO / "cases").glob("spiral_bevel_*.toml"))
 
 
-@pytest.mark.parametrize("path", BEVEL_CASES, ids=[p.stem for p in BEVEL_CASES])
+# dE and dgamma by default; dG and dP (the same machinery, one more loaded cycle each) slow
+@pytest.mark.parametrize(
+    "path",
+    [
+        pytest.param(p, marks=pytest.mark.slow)
+        if p.stem in ("spiral_bevel_dG", "spiral_bevel_dP")
+        else p
+        for p in BEVEL_CASES
+    ],
+    ids=[p.stem for p in BEVEL_CASES],
+)
 def test_spiral_bevel_case_smoke(tmp_path, path):
     """Unloaded TCA of each spiral bevel case at 5 positions (the machine-setting synthesis,
     ~15 s, runs once per process for the shared blank data); the cases ask for ``hybrid``, run

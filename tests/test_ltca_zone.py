@@ -101,6 +101,7 @@ def test_positions_without_grids_are_refused(cycle):
         contact_zone(bare, tca.fm1.bounds, tca.fm2.bounds, "drive", "drive", 0.02)
 
 
+@pytest.mark.slow  # two sets of face-gear sectors built cold: minutes
 def test_a_load_beyond_the_zone_grows_it_and_models_the_new_pair():
     """Seed face gear at 2x its rated load (6e6 N·mm on the face gear). The sectors start on the
     sampled zone at ``g_max`` = 0.02 mm: pairs (0, 0) and (-1, -1). Pair (1, 1) comes within
