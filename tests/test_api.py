@@ -241,7 +241,7 @@ def test_flank_views_hold_the_loaded_cells_in_flank_coordinates(fzg):
     """Read back from the files: every loaded cell of both members, its force and pressure the
     solver's; the FZG gear's face coordinate is the axial position of the gear-side cell
     centres (an independent measure: the fixed frame's z)."""
-    from fegear.output.flank_view import read_flank_vtp
+    from fegear.output.flank_vtp import read_flank_vtp
 
     result, _, root, _ = fzg
     run = result.run

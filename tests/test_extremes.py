@@ -351,7 +351,7 @@ def test_temporary_files_of_a_killed_write_are_removed_by_the_next_run(tmp_path,
 
 def test_the_cache_is_cleaned_when_a_run_starts(tmp_path, monkeypatch):
     import fegear
-    import fegear.api as api
+    import fegear.api.runner as api
     from fegear.store.cache import check_cache_root
 
     monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))

@@ -39,6 +39,7 @@ from fegear.errors import InputError
 from fegear.ltca.hertz_model import solve_position_hertz
 from fegear.ltca.hybrid import hybrid_compliance
 from fegear.ltca.model import cell_load_operators, member_compliance
+from fegear.ltca.position import solve_position
 
 if TYPE_CHECKING:  # the option and model types (fegear.ltca.analysis imports this module)
     from fegear.ltca.analysis import LTCAOptions, MemberModels
@@ -119,10 +120,7 @@ class FE:
         return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
 
     def solve_position(self, tca, pos, models, torque2_Nmm, options, previous):
-        # analysis imports this module for the registry: its solver is looked up at call time
-        from fegear.ltca import analysis
-
-        return analysis.solve_position(tca, pos, models, torque2_Nmm, options.g_max_mm, previous)
+        return solve_position(tca, pos, models, torque2_Nmm, options.g_max_mm, previous)
 
 
 class Hybrid(FE):

@@ -39,7 +39,7 @@ At coarse FE levels the FE under-estimates the local deformation, so ``c_i`` is 
 A pair whose closest point lies on a flank edge is an edge contact: the law of the flanks'
 curvatures there gives its force (continuous with the interior), but its pressure is the edge's
 (singular), which no closed form gives: its pressures are None with the reason
-(:attr:`fegear.ltca.results.PairLoad.pressure_reason`). A pair within reach of contact that gets
+(:attr:`fegear.ltca.results.PairContact.pressure_reason`). A pair within reach of contact that gets
 no law (no curvature, a relative curvature that is not positive, no line length) makes the
 position degenerate if the lag closes it (its load would be missing from the balance).
 """
@@ -59,7 +59,7 @@ from fegear.geometry.transforms import apply_vectors, compose
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
 from fegear.ltca.grid import pair_cells, separation_at, take_cells, tca_edge_names
-from fegear.ltca.results import LoadedPosition, PairLoad
+from fegear.ltca.results import LoadedPosition, PairContact
 from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
 from fegear.tca.results import ARCSEC, PositionResult
@@ -494,7 +494,7 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
             )
         p_val = float(p0) if not why else float("nan")
         loads.append(
-            PairLoad(
+            PairContact(
                 k=k,
                 j=j,
                 force_N=float(f),

@@ -36,6 +36,7 @@ import numpy as np
 
 from fegear import __version__
 from fegear.store.files import atomic_write, write_json
+from fegear.sweep.marker import verified_summary
 
 __all__ = [
     "TE_FLOOR_ARCSEC",
@@ -121,8 +122,6 @@ def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
 
 def _read_summary(folder: Path) -> dict[str, Any] | None:
     """The item's summary.json, only if it is the complete one its marker vouches for."""
-    from fegear.sweep.run import verified_summary
-
     return verified_summary(folder)
 
 

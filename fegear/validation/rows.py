@@ -323,7 +323,7 @@ def fzg_rows(runs: Sequence[PitchPointRun], case=None) -> list[Row]:
     """The FZG rows (line Hertz p_max at mid-face, ISO 6336-1 c'th) from pitch-point runs."""
     case = case or _case("fzg_spur.toml")
     h, c = fzg_reference(case)
-    T = case.torque2_Nmm / 1000.0
+    T = case.torque2_Nm
     where = f"FZG type C, {T:g} N·m on the gear, at the pitch point (φ1 = {runs[0].phi1_deg:.3f}°)"
 
     def note(r: PitchPointRun) -> str:
