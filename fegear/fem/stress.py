@@ -1,4 +1,5 @@
-"""Stress recovery on the P2 sectors and the root stress of each tooth (DESIGN §10).
+"""Stress recovery on the P2 sectors and the root stress of each tooth (``docs/architecture.md``:
+the result model).
 
 The displacement ``u`` of a sector is quadratic on each tetrahedron (``ElementTetP2`` on the
 linear tet mesh, :mod:`fegear.fem.elasticity`), so the strain is linear on each element and

@@ -1,10 +1,10 @@
 """Gear-pair case files (TOML): schema and validation, read into a :class:`GearCase`.
 
-Units are in the key names (DESIGN §3). Unknown sections and keys are refused with the closest
-known key suggested (which catches a wrong unit suffix: ``module_in`` → ``module_mm``), missing
-required keys are refused, and every error is an :class:`~fegear.errors.InputError` naming the
-case-file field, the value and the allowed range, so that ``fegear run`` prints one line and exits
-with code 2 before any work.
+Units are in the key names (``docs/conventions.md``). Unknown sections and keys are refused with the
+closest known key suggested (which catches a wrong unit suffix: ``module_in`` → ``module_mm``),
+missing required keys are refused, and every error is an :class:`~fegear.errors.InputError` naming
+the case-file field, the value and the allowed range, so that ``fegear run`` prints one line and
+exits with code 2 before any work.
 
 The schema is declared once, as :class:`~fegear.io.schema.Section` objects (:func:`sections`):
 the validation, the defaults and the case-file reference (:func:`reference`,
@@ -67,7 +67,7 @@ __all__ = [
 GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel")
 #: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
 PARALLEL_KINDS = ("spur", "cylindrical")
-#: Fidelities of the gear pairs (DESIGN §9).
+#: Fidelities of the gear pairs (``docs/fidelity.md``).
 #: The unloaded analysis (rigid TCA only); the others are the loaded fidelities of
 #: :data:`fegear.ltca.fidelity.FIDELITIES` (tests/test_architecture.py keeps the two in step).
 UNLOADED = "tca"

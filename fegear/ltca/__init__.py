@@ -1,4 +1,5 @@
-"""Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair (DESIGN §7-§10)."""
+"""Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair
+(``docs/ltca/contact_formulation.md``, ``docs/fidelity.md``)."""
 
 from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models
 from fegear.ltca.cycle import run_ltca

@@ -1,9 +1,9 @@
 """The ``hertz`` fidelity: multi-pair load sharing with per-pair Hertz laws and lumped compliance.
 
-The seed's multi-pair algorithm (DESIGN §9). At a position, pair ``i`` has, from the TCA, its
-smallest separation ``b_i`` (mm, along the pinion normal; 0 for the pair in contact) and the
-moment arm ``h_i`` (mm/rad) of its normal about the member-2 axis. A lag ``θ`` of member 2 gives
-it the approach ``Δ_i = θ h_i − b_i``; where ``Δ_i > 0`` it carries the force ``F_i`` solving
+The seed's multi-pair algorithm (``docs/fidelity.md``). At a position, pair ``i`` has, from the TCA,
+its smallest separation ``b_i`` (mm, along the pinion normal; 0 for the pair in contact) and the
+moment arm ``h_i`` (mm/rad) of its normal about the member-2 axis. A lag ``θ`` of member 2 gives it
+the approach ``Δ_i = θ h_i − b_i``; where ``Δ_i > 0`` it carries the force ``F_i`` solving
 
 .. math:: \\delta^H_i(F_i) + c_i F_i = \\Delta_i ,
 

@@ -1,8 +1,8 @@
 """Typed results of the loaded tooth contact analysis (frozen dataclasses).
 
 Units: force N, torque N·mm (reported N·m in summaries), pressure MPa, lengths mm, TE arcsec.
-Sign conventions (DESIGN §3): ``theta`` is the elastic lag of member 2 (rad, positive against its
-driving sense); the loaded TE is the unloaded TE minus that lag.
+Sign conventions (``docs/conventions.md``): ``theta`` is the elastic lag of member 2 (rad, positive
+against its driving sense); the loaded TE is the unloaded TE minus that lag.
 """
 
 from __future__ import annotations
@@ -243,7 +243,8 @@ class Excluded:
 
 @dataclass(frozen=True)
 class CycleHeadline:
-    """The cycle's headline numbers, each meaning what it says (DESIGN §10).
+    """The cycle's headline numbers, each meaning what it says (``docs/architecture.md``: the result
+    model).
 
     A value is None when nothing physical can be reported, with the reason next to it.
 

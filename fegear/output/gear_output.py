@@ -1,4 +1,5 @@
-"""Outputs of a gear-case run (DESIGN §10): ``summary.json``, VTK time series, PNGs.
+"""Outputs of a gear-case run (the result model: ``docs/architecture.md``): ``summary.json``, VTK
+time series, PNGs.
 
 Files written to the output folder (each one atomically: complete or absent):
 

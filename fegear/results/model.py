@@ -15,7 +15,7 @@ The typed fields are the numbers a user reads and compares; the records that onl
 have and that are read as a whole (the contact ellipses, the TE harmonics, the root-stress
 rows, the solver residuals of each position, the cylindrical section, the validity checks) are
 kept as their JSON-ready mappings (``Mapping[str, Any]``: the keys of ``summary.json``, plain
-floats, ints, strings, lists; :doc:`docs/summary_json.md` documents them).
+floats, ints, strings, lists; ``docs/cli/README.md`` documents them).
 """
 
 from __future__ import annotations

@@ -517,7 +517,7 @@ def bevel_rows(b: BevelParabola) -> list[Row]:
 # Seed trend: TE, contact ratio and patch size grow with the load
 # --------------------------------------------------------------------------------------------
 
-#: The seed face gear at its light, moderate and heavy loads (DESIGN §4).
+#: The seed face gear at its light, moderate and heavy loads (``docs/reference_pairs.md``).
 TREND_CASES = (
     "face_gear_load_light.toml",
     "face_gear_load_moderate.toml",
