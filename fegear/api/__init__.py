@@ -13,9 +13,10 @@ A case is frozen: :meth:`~fegear.io.gear_case.GearCase.replace` and
 :meth:`~fegear.io.gear_case.GearCase.with_errors` return a new case validated exactly like a case
 file (a bad field raises the :class:`~fegear.errors.InputError` the case file would).
 :func:`run` returns a :class:`GearResult` (gear pairs) or a :class:`HertzResult` (the Hertz
-scene): typed, frozen, with the numbers of ``summary.json`` — the same values, built from the
-same document — and ``write(folder)``, which writes the files ``fegear run`` writes (the command
-is a layer over this module). Units are in the names (mm, N, MPa, N·m, arcsec, deg).
+scene): typed, frozen, with the numbers of ``summary.json`` — a gear result hands out the result
+model (:mod:`fegear.results`) that ``summary.json`` is written from — and ``write(folder)``,
+which writes the files ``fegear run`` writes (the command is a layer over this module). Units
+are in the names (mm, N, MPa, N·m, arcsec, deg).
 
 For scripts that compare runs (one per installation error, say): :func:`table` (a text table of
 the headline numbers and the pattern shift), :func:`plot_te` and :func:`plot_patterns`.
