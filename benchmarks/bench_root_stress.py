@@ -4,7 +4,7 @@ The loaded analysis runs once, at the two pinion angles where the pinion's and t
 tooth carry the whole load highest on the flank (their loaded outer points of single contact,
 :func:`fegear.validation.iso6336_root.fe_root_stress`); its cell forces then load stress sectors
 whose fillets on the read tooth are refined to ``h = FILLET_MODULES[k] · m``
-(:func:`fegear.pipeline.run.displacements`, ``refine_teeth``). Per level: the tension-fillet
+(:func:`fegear.pipeline.fields.displacements`, ``refine_teeth``). Per level: the tension-fillet
 maximum principal stress with the averaged vertex recovery (the default) and the largest
 unaveraged element value, the sector size and the time. The observed order ``p`` and the
 extrapolated value ``σ_0`` come from a least-squares fit of both recoveries with one limit
@@ -65,7 +65,7 @@ def main() -> int:
     from fegear.fem.stress import FILLET_MODULES as DEFAULT
     from fegear.fem.stress import VertexStress, fillet_regions, principal_stresses
     from fegear.ltca import LTCAOptions, run_ltca
-    from fegear.pipeline.run import displacements
+    from fegear.pipeline.fields import displacements
     from fegear.tca.results import ARCSEC
     from fegear.validation.iso6336_root import _fzg_case, fe_root_stress, fzg_reference
 

@@ -3,9 +3,10 @@ reference spiral bevel pair.
 
 Run: ``python benchmarks/bench_tca.py``. Times (wall clock, best of 3): the full ``run_tca``
 (reference phase + 25 positions × 3 pairs, separation grids 15 × 9, Hertz at 350.14 N·m) and the
-same without separation grids. Spiral bevel (12/36, DESIGN §4; ``SpiralBevelPair.design()`` is
-not timed): the first run ("cold") includes building the native flank tables of both members
-(:class:`fegear.geometry.spiral_bevel.NativeFlank`), then best of 3 with and without grids.
+same without separation grids. Spiral bevel (12/36, docs/reference_pairs.md;
+``SpiralBevelPair.design()`` is not timed): the first run ("cold") includes building the native
+flank tables of both members (:class:`fegear.geometry.spiral_bevel.NativeFlank`), then best of 3
+with and without grids.
 """
 
 from __future__ import annotations

@@ -13,8 +13,8 @@ driving rotation about the member ``z`` axis, ``φ_i`` the rotation angle in the
 :func:`fegear.tca.reference_phase`) and ``C_i`` a constant member-frame transform. Tooth ``k``
 of a member is tooth 0 turned by ``k·2π/N`` about the member ``z`` axis (``tooth_transform``).
 
-Sign conventions (written once; DESIGN §3; figure ``docs/tca/assembly_conventions.png``)
----------------------------------------------------------------------------------------
+Sign conventions (written once; ``docs/conventions.md``, ``docs/tca/assembly_conventions.png``)
+-----------------------------------------------------------------------------------------------
 Intersecting axes (face gear, spiral bevel). The axes of the error-free pair intersect at the
 crossing point ``O`` (bevel: the pitch-cone apex; face gear: the point of the face-gear axis at the
 height ``r_p1`` of the pinion axis). Fixed frame: member-2 axis ``+z`` (face gear) or

@@ -190,7 +190,6 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     from fegear.api import run
     from fegear.io.gear_case import UNLOADED
     from fegear.ltca.fidelity import FIDELITIES
-    from fegear.pipeline.run import report
     from fegear.store.outputs import inspect_output_folder
 
     if args.study:
@@ -232,7 +231,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             stage_t["started"] = True
             say(
                 f"fegear {__version__}: case {case.name!r} ({case.source}), {case.kind}, "
-                f"T2 {case.torque2_Nmm / 1000:.1f} N·m, fidelity {fid}"
+                f"T2 {case.torque2_Nm:.1f} N·m, fidelity {fid}"
                 + (f", level {lvl}" if fid != UNLOADED else "")
                 + f", {case.n_positions} positions, out {out}/"
             )
@@ -257,7 +256,6 @@ def _run_gear(args: argparse.Namespace, case) -> int:
     progress("writing", None, None)
     paths = result.write(out, overwrite=args.overwrite)
     say(f"    {folder.describe()}")
-    rep = report(result.run)
     c = result.cycle
     if result.fidelity != UNLOADED:
         used = f" over {c.te_pp_loaded_positions_used} of {c.n_positions} positions"
@@ -302,10 +300,9 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             f"{ch.path_length_mm:.1f} mm on the {result.run.pair.gear.name.replace('_', '-')} "
             f"flank, from {start.replace(':', ' ')} to {end.replace(':', ' ')}"
         )
-    for w in rep.warnings:
+    for w in result.model.warnings:  # the run's warnings (the solver's notes: below)
         warn(w)
-    cyc = result.run.cycle
-    n_other = sum(bool(p.warnings) for p in cyc.positions) if cyc is not None else 0
+    n_other = sum(bool(p.warnings) for p in result.positions)
     if n_other:
         say(f"    {n_other} positions with solver notes (summary.json: positions[i].warnings)")
     kinds = (
@@ -434,7 +431,8 @@ def _size(n: int) -> str:
 def _plot(args: argparse.Namespace) -> int:
     import json
 
-    from fegear.output.flank_view import plot_flank_pattern, read_flank_vtp
+    from fegear.output.flank_view import plot_flank_pattern
+    from fegear.output.flank_vtp import read_flank_vtp
     from fegear.store.files import journal
     from fegear.store.outputs import MANIFEST, run_files
 

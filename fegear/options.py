@@ -28,7 +28,7 @@ def _positive(value: object) -> bool:
 
 @dataclass(frozen=True)
 class ContactOptions:
-    """Tuning of the loaded contact models (defaults: the measured choices of DESIGN §7-§9).
+    """Tuning of the loaded contact models (defaults: the measured choices of ``docs/fidelity.md``).
 
     Attributes
     ----------

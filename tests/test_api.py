@@ -4,7 +4,7 @@ views and ``fegear plot``.
 
 - Cases are frozen and validated like case files: every change goes through the case-file
   parser, so a bad field raises the very ``InputError`` a bad case file raises.
-- A result holds the numbers of its ``summary.json`` (built from the same document) and writes
+- A result holds the numbers of its ``summary.json`` (both are its result model) and writes
   the same files as the command line.
 - The flank views hold the solver's loaded cells on each member's flank: their forces add up to
   the position's, and on the FZG gear the face coordinate is the cells' axial position.
@@ -184,7 +184,7 @@ def test_result_holds_the_summary_numbers(fzg):
     keys = ("te_pp_unloaded_arcsec", "te_pp_loaded_arcsec", "contact_ratio_loaded", "p_max_MPa",
             "p_max_edge_MPa", "te_pp_loaded_positions_used", "n_positions")  # fmt: skip
     for key in keys:
-        assert getattr(result.cycle, key) == c[key], key  # the same document: exact
+        assert getattr(result.cycle, key) == c[key], key  # the same model: exact
     assert result.cycle.p_max_pair == tuple(c["p_max_at"]["pair"])
     assert result.checks.contact_ratio_unloaded == c["contact_ratio_unloaded"]
     assert result.checks.path_ends == tuple(c["path_ends"])
@@ -241,7 +241,7 @@ def test_flank_views_hold_the_loaded_cells_in_flank_coordinates(fzg):
     """Read back from the files: every loaded cell of both members, its force and pressure the
     solver's; the FZG gear's face coordinate is the axial position of the gear-side cell
     centres (an independent measure: the fixed frame's z)."""
-    from fegear.output.flank_view import read_flank_vtp
+    from fegear.output.flank_vtp import read_flank_vtp
 
     result, _, root, _ = fzg
     run = result.run

@@ -1,6 +1,7 @@
-"""The package graph of fegear: read from the source (every ``import`` statement, including the
-function-local ones), it has no cycles, and the case-file layer ``fegear.io`` reads and
-validates without reaching into the model layers or the pipeline above them."""
+"""The import graph of fegear, read from the source (every ``import`` statement, including the
+function-local ones): no cycle between packages, none between modules, and the case-file layer
+``fegear.io`` reads and validates without reaching into the model layers or the pipeline above
+them. The modules of the result model, the pipeline, the writers and the API stay short."""
 
 from __future__ import annotations
 
@@ -105,6 +106,55 @@ def _cycles(graph: dict[str, dict[str, list[str]]]) -> list[list[str]]:
     return out
 
 
+def _runtime_imports(path: Path) -> list[tuple[str, int]]:
+    """``[(imported fegear module, line)]`` of one source file as Python runs it: imports under
+    ``if TYPE_CHECKING:`` left out (annotations only), ``from package import name`` resolved to
+    the module ``package.name`` where ``name`` is one."""
+    module = _module_name(path)
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    typing_only = {
+        id(n)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+        for stmt in node.body
+        for n in ast.walk(stmt)
+    }
+    out = []
+    for node in ast.walk(tree):
+        if id(node) in typing_only:
+            continue
+        if isinstance(node, ast.Import):
+            out += [(a.name, node.lineno) for a in node.names if a.name.startswith("fegear")]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target == "fegear" or target.startswith("fegear."):
+                out += [(f"{target}.{a.name}", node.lineno) for a in node.names]
+    return out
+
+
+def _module_graph() -> dict[str, dict[str, list[str]]]:
+    """``{module: {imported module: ["path:line", ...]}}`` over every source file (an import of
+    a name resolves to the deepest module that holds it: ``fegear.ltca.grid.pair_cells`` →
+    ``fegear.ltca.grid``)."""
+    modules = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+    graph: dict[str, dict[str, list[str]]] = {}
+    for src, path in modules.items():
+        for target, line in _runtime_imports(path):
+            dst = target
+            while dst and dst not in modules:
+                dst = dst.rpartition(".")[0]
+            if dst in ("", "fegear", src):
+                continue
+            where = f"{path.relative_to(PACKAGE.parent)}:{line}"
+            graph.setdefault(src, {}).setdefault(dst, []).append(where)
+    return graph
+
+
 def test_graph_reader_sees_the_known_edges():
     """The reader is not blind: edges that must exist are found (a broken reader that returns
     nothing would pass the two tests below)."""
@@ -113,6 +163,49 @@ def test_graph_reader_sees_the_known_edges():
     assert "io" in g["pipeline"]  # ... of a case read by io
     assert "contact" in g["ltca"]  # the LTCA solves with the contact solver
     assert "pipeline" in g["output"]  # the writers read a GearRun
+
+
+def test_module_graph_reader_sees_the_known_edges():
+    g = _module_graph()
+    assert "fegear.ltca.position" in g["fegear.ltca.fidelity"]  # FE solves a position
+    assert "fegear.linalg._mkl_pardiso" in g["fegear.linalg.schur"]  # from package import module
+    assert "fegear.results.build" in g["fegear.output.gear_output"]  # the writers read the model
+    # annotations only: analysis's types in fidelity are no import at run time
+    assert "fegear.ltca.analysis" not in g["fegear.ltca.fidelity"]
+
+
+def test_module_graph_has_no_cycles():
+    """No module imports, directly or through others, a module that imports it (function-local
+    imports included: they hide a circle, they do not remove it)."""
+    g = _module_graph()
+    cycles = _cycles(g)
+    detail = [
+        f"{a} -> {b}: {', '.join(g[a][b])}"
+        for comp in cycles
+        for a in comp
+        for b in comp
+        if b in g.get(a, {})
+    ]
+    assert not cycles, "module cycles:\n" + "\n".join(detail)
+
+
+#: The modules whose length is capped (lines): the result model, the pipeline, the writers, the
+#: Python API. A module of one concept fits; two concepts in one module are split.
+SHORT_MODULES = ("results", "pipeline", "output", "api")
+MAX_LINES = 600
+
+
+@pytest.mark.parametrize("part", SHORT_MODULES)
+def test_result_pipeline_output_and_api_modules_are_short(part):
+    root = PACKAGE / part
+    paths = sorted(root.rglob("*.py")) if root.is_dir() else [PACKAGE / f"{part}.py"]
+    assert paths and all(p.exists() for p in paths), part
+    long = {
+        str(p.relative_to(PACKAGE.parent)): n
+        for p in paths
+        if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES
+    }
+    assert not long, f"modules over {MAX_LINES} lines: {long}"
 
 
 def test_package_graph_has_no_cycles():

@@ -9,8 +9,9 @@ Two kinds of reference:
   solution is unique and can be found independently by enumerating active sets (n ≤ 8) or by
   ``scipy.optimize.minimize`` (SLSQP).
 
-Tolerance tiers (DESIGN §12): what the solver enforces (equilibrium, complementarity, the gap on
-active cells) to round-off; the half-space discretisation against Hertz to a fraction of a percent.
+Tolerance tiers (docs/testing.md): what the solver enforces (equilibrium, complementarity, the gap
+on active cells) to round-off; the half-space discretisation against Hertz to a fraction of a
+percent.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ NU_STEEL = 0.3
 E_STAR = effective_modulus(E_STEEL, NU_STEEL, E_STEEL, NU_STEEL)
 LOAD = 2000.0  # N, the roller scene's load
 
-EQ_TOL = 1e-9  # DESIGN §11: equilibrium to 1e-9 relative
+EQ_TOL = 1e-9  # docs/testing.md: equilibrium to 1e-9 relative
 
 
 # ----------------------------------------------------------------------------------------------
@@ -167,7 +168,7 @@ def _assert_kkt(C, g, h, T, sol: ContactSolution, *, tol: float = 1e-9) -> None:
     """
     F = sol.force
     assert np.all(np.isfinite(F)) and math.isfinite(sol.theta)
-    # equilibrium: exactly what the solver enforces, DESIGN §11
+    # equilibrium: exactly what the solver enforces, docs/testing.md
     assert abs(math.fsum(h * F) - T) / T <= EQ_TOL, f"h^T F = {math.fsum(h * F)!r}, T = {T!r}"
     # no tension, and the active set is exactly the support of F
     assert np.all(F >= 0.0)
@@ -331,7 +332,7 @@ def test_uniform_moment_arm_is_a_scaled_force_balance(sphere6) -> None:
 
 
 # ----------------------------------------------------------------------------------------------
-# extremes (DESIGN §11)
+# extremes (docs/testing.md)
 # ----------------------------------------------------------------------------------------------
 
 
@@ -452,7 +453,7 @@ def test_equilibrium_exact_under_cancellation(sphere6, case: str) -> None:
         C, g, _ = sphere6
         g = g - 0.01  # 10 µm initial overlap at the centre
         h = np.ones(g.size)
-        T = 1e-6  # DESIGN §11: 1e-6 of rated
+        T = 1e-6  # docs/testing.md: 1e-6 of rated
     else:
         rng = np.random.default_rng(108)  # found by a sweep of 300 seeds; n = 2, both active
         n = int(rng.integers(2, 30))

@@ -13,14 +13,14 @@ import numpy as np
 import pytest
 
 from fegear.ltca.degenerate import position_status, unresolved_share
-from fegear.ltca.results import DEGENERATE_SHARE, PairLoad
+from fegear.ltca.results import DEGENERATE_SHARE, PairContact
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 ARCSEC = math.radians(1.0 / 3600.0)
 
 
-def _pair(k: int, share: float, across: float) -> PairLoad:
-    return PairLoad(
+def _pair(k: int, share: float, across: float) -> PairContact:
+    return PairContact(
         k=k, j=-k, force_N=1000.0 * share, torque_Nmm=share, load_share=share, p_max_MPa=1.0,
         p_peak_MPa=1.0, semi_major_mm=1.0, semi_minor_mm=0.05 * across, n_active=3,
         edge_contact=True, contact_point=np.zeros(3), cells_across=across,
@@ -104,4 +104,4 @@ def test_the_seed_face_gear_entering_pair_on_both_sides(seed_face_gear, case, po
     assert p.status == expected
     assert (share >= DEGENERATE_SHARE) == (expected == "degenerate"), share
     h = c.headline()
-    assert (h.te_pp_positions_used == 0) == (expected == "degenerate")
+    assert (h.te_pp_loaded_positions_used == 0) == (expected == "degenerate")

@@ -126,7 +126,7 @@ else:
 
 
 def test_versions_record_absent_packages(monkeypatch) -> None:
-    from fegear.output import records
+    from fegear.results import records
 
     real = importlib.metadata.version
 
@@ -163,7 +163,8 @@ def test_flank_views_written_and_read_without_pyvista(tmp_path) -> None:
 from pathlib import Path
 
 import numpy as np
-from fegear.output.flank_view import FlankFrame, FlankPatch, read_flank_vtp, write_flank_vtp
+from fegear.output.flank_view import FlankFrame, FlankPatch
+from fegear.output.flank_vtp import read_flank_vtp, write_flank_vtp
 rng = np.random.default_rng(0)
 outline = rng.standard_normal((11, 2))
 quads = rng.standard_normal((7, 4, 2))

@@ -351,7 +351,7 @@ def test_temporary_files_of_a_killed_write_are_removed_by_the_next_run(tmp_path,
 
 def test_the_cache_is_cleaned_when_a_run_starts(tmp_path, monkeypatch):
     import fegear
-    import fegear.api as api
+    import fegear.api.runner as api
     from fegear.store.cache import check_cache_root
 
     monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
@@ -369,6 +369,7 @@ def test_plot_draws_only_the_files_of_the_folders_run(tmp_path, monkeypatch, cap
     """``fegear plot`` reads the flank views the folder's run listed (``summary.json``), never a
     stale one of another run left beside them."""
     import fegear.output.flank_view as fv
+    import fegear.output.flank_vtp as fvtp
     from fegear.store.outputs import MANIFEST
 
     out = tmp_path / "out"
@@ -381,7 +382,7 @@ def test_plot_draws_only_the_files_of_the_folders_run(tmp_path, monkeypatch, cap
            "files": listed, "versions": {"fegear": "0"}}  # fmt: skip
     (out / "summary.json").write_text(json.dumps(doc), encoding="utf-8")
     read = []
-    monkeypatch.setattr(fv, "read_flank_vtp", lambda f: read.append(Path(f).name) or (0, 0, 0))
+    monkeypatch.setattr(fvtp, "read_flank_vtp", lambda f: read.append(Path(f).name) or (0, 0, 0))
     written = []
 
     def fake_plot(frame, patches, png, *a):  # writes as the real one does (atomically)

@@ -1,4 +1,5 @@
-"""Gear-pair cases and ``fegear run`` on them (issue 8; DESIGN §3, §10, §12).
+"""Gear-pair cases and ``fegear run`` on them (issue 8; docs/conventions.md, docs/architecture.md,
+docs/testing.md).
 
 - Every case file in ``cases/`` loads and validates (fast); malformed gear cases end with one
   line on stderr naming the problem and exit code 2, before any work.

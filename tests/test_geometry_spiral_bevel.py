@@ -1,7 +1,8 @@
 """Spiral bevel generation, synthesis and a small TCA of the mean tooth pair (reference design).
 
-Reference pair (DESIGN §4): 12/36 teeth, outer module 4.94 mm, β 35°, α 22.5°, F 25.4 mm, Σ 90°,
-predesigned parabolic TE 8 arcsec. Mesh frame: apex at the origin, pinion axis +z, gear axis +x.
+Reference pair (docs/reference_pairs.md): 12/36 teeth, outer module 4.94 mm, β 35°, α 22.5°, F 25.4
+mm, Σ 90°, predesigned parabolic TE 8 arcsec. Mesh frame: apex at the origin, pinion axis +z, gear
+axis +x.
 """
 
 from __future__ import annotations

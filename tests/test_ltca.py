@@ -1,4 +1,5 @@
-"""Loaded tooth contact analysis of the FZG type C spur pair (DESIGN §4, §8; issue 6).
+"""Loaded tooth contact analysis of the FZG type C spur pair (docs/reference_pairs.md,
+docs/ltca/contact_formulation.md; issue 6).
 
 FE sectors of 5 teeth (the 3 that can touch + a neighbour each side) at mesh level 0, TCA gaps,
 torque-balanced active-set contact. The invariants hold exactly (the solver enforces them); the

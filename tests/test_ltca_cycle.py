@@ -231,7 +231,7 @@ def test_a_trim_that_leaves_loaded_cells_out_is_caught(fzg, caplog) -> None:
     is solved again on all cells: the answer is that of all cells."""
     asm, opt, models = fzg
     full = run_ltca(PINION, GEAR, asm, RATED, replace(opt, trim=0.0, workers=1), models=models)
-    with caplog.at_level("INFO", logger="fegear.ltca.analysis"):
+    with caplog.at_level("INFO", logger="fegear.ltca.position"):
         tight = run_ltca(
             PINION, GEAR, asm, RATED, replace(opt, trim=0.01, workers=1), models=models
         )

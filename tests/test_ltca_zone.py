@@ -1,6 +1,6 @@
-"""The contact zone of a cycle (DESIGN §6, :mod:`fegear.ltca.zone`): which teeth the sectors need
-and where their meshes must be fine, from the TCA alone (FZG type C spur pair, contact ratio
-1.46, and a face gear with localized contact)."""
+"""The contact zone of a cycle (docs/mesh/README.md, :mod:`fegear.ltca.zone`): which teeth the
+sectors need and where their meshes must be fine, from the TCA alone (FZG type C spur pair, contact
+ratio 1.46, and a face gear with localized contact)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Tooth-sector meshes (DESIGN §6): named groups, flank accuracy, volume, static convergence.
+"""Tooth-sector meshes (docs/mesh/README.md): named groups, flank accuracy, volume, static
+convergence.
 
 Meshes are cached (``meshes/cache`` or ``$FEGEAR_CACHE``); a cold run meshes the coarsest levels
 only. The default suite checks the FZG pinion and the face gear; the face-gear pinion and the

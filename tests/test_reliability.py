@@ -342,9 +342,9 @@ def test_degenerate_positions_are_flagged_and_left_out_of_the_te(tmp_path, capsy
 
 
 def _pair(k, share, p_int=None, p_edge=None, edges=(), resolved=True):
-    from fegear.ltca.results import PairLoad
+    from fegear.ltca.results import PairContact
 
-    return PairLoad(
+    return PairContact(
         k=k, j=-k, force_N=1000.0 * share, torque_Nmm=share, load_share=share,
         p_max_MPa=max(x for x in (p_int, p_edge, 0.0) if x is not None), p_peak_MPa=0.0,
         semi_major_mm=1.0, semi_minor_mm=0.1, n_active=10, edge_contact=bool(edges),
@@ -393,11 +393,11 @@ def test_headline_leaves_out_what_is_not_usable():
          "ok"),
     ])  # fmt: skip
     h = c.headline()
-    assert h.te_pp_loaded_arcsec == 2.0 and h.te_pp_positions_used == 2  # not 500
-    assert [(e.index, e.status) for e in h.excluded] == [(1, "degenerate"), (2, "lost")]
+    assert h.te_pp_loaded_arcsec == 2.0 and h.te_pp_loaded_positions_used == 2  # not 500
+    assert [(e.index, e.status) for e in h.excluded_positions] == [(1, "degenerate"), (2, "lost")]
     assert h.p_max_MPa == 1000.0 and h.p_max_position == 0
     assert h.p_max_edge_MPa == 9000.0 and h.p_max_edge_edges == ("gear tip",)
-    assert h.edge_positions == (3,)
+    assert h.positions_with_edge_contact == (3,)
 
 
 def test_headline_is_null_with_a_reason_never_zero():
@@ -410,12 +410,12 @@ def test_headline_is_null_with_a_reason_never_zero():
     assert "gear heel" in h.p_max_reason and h.p_max_edge_MPa == 6000.0
     nothing = _cycle([(0.0, [], "lost"), (-3.0, [_pair(0, 1.0, resolved=False)], "degenerate")])
     h = nothing.headline()
-    assert h.te_pp_loaded_arcsec is None and h.te_pp_positions_used == 0
-    assert "no usable position (1 degenerate, 1 lost" in h.te_pp_reason
+    assert h.te_pp_loaded_arcsec is None and h.te_pp_loaded_positions_used == 0
+    assert "no usable position (1 degenerate, 1 lost" in h.te_pp_loaded_reason
     assert h.p_max_MPa is None and h.p_max_reason.startswith("no usable position")
     one = _cycle([(-1.0, [_pair(0, 1.0, p_int=800.0)], "ok"), (0.0, [], "lost")])
     assert one.headline().te_pp_loaded_arcsec is None
-    assert "only one usable position" in one.headline().te_pp_reason
+    assert "only one usable position" in one.headline().te_pp_loaded_reason
 
 
 # --------------------------------------------------------------------------------------------

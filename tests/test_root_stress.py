@@ -1,4 +1,4 @@
-"""Root stress from the stress sectors (fegear.fem.stress, fegear.pipeline.run.displacements) and
+"""Root stress from the stress sectors (fegear.fem.stress, fegear.pipeline.fields.displacements) and
 the ISO 6336-3 method B reference (fegear.validation.iso6336_root)."""
 
 from __future__ import annotations
@@ -82,8 +82,9 @@ def fzg_stress():
     """FZG hybrid level 0 at two positions (one in single contact), loaded stress sectors with
     coarse fillets (0.5 m: a small solve; the equilibrium does not depend on the size)."""
     from fegear.ltca import LTCAOptions, build_models, run_ltca
+    from fegear.pipeline.fields import displacements
     from fegear.pipeline.pair import build_pair
-    from fegear.pipeline.run import GearRun, displacements
+    from fegear.pipeline.run import GearRun
     from fegear.tca.results import ARCSEC
     from fegear.validation.iso6336_root import _fzg_case
 
@@ -149,7 +150,7 @@ def test_summary_has_the_root_stress_keys(fzg_stress):
 def test_vtk_sectors_carry_the_stress_fields(fzg_stress, tmp_path):
     import meshio
 
-    from fegear.output.gear_output import _member_mesh, _write_vtu
+    from fegear.output.vtk import _member_mesh, _write_vtu
 
     mf = fzg_stress.members[0]
     path = _write_vtu(tmp_path / "p.vtu", _member_mesh(mf, 0, fzg_stress.cycle.positions[0]))

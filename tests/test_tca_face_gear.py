@@ -1,4 +1,5 @@
-"""TCA of the seed face gear (DESIGN §4): localized contact, Δγ = −0.02°, 0, +0.02°, Hertz."""
+"""TCA of the seed face gear (docs/reference_pairs.md): localized contact, Δγ = −0.02°, 0, +0.02°,
+Hertz."""
 
 from __future__ import annotations
 

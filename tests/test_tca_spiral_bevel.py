@@ -1,5 +1,6 @@
-"""Unloaded TCA of the reference spiral bevel pair (DESIGN §4, §5): 12/36 teeth, 35°, 22.5°,
-predesigned parabolic TE of 8 arcsec, path angle −8° (drive) on the gear flank."""
+"""Unloaded TCA of the reference spiral bevel pair (docs/reference_pairs.md, docs/tca/README.md):
+12/36 teeth, 35°, 22.5°, predesigned parabolic TE of 8 arcsec, path angle −8° (drive) on the gear
+flank."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""TCA of the FZG type C spur pair (DESIGN §4): conjugacy, line of action, contact ratio,
-axis-parallelism errors, loss of contact, the separation grid."""
+"""TCA of the FZG type C spur pair (docs/reference_pairs.md): conjugacy, line of action, contact
+ratio, axis-parallelism errors, loss of contact, the separation grid."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""Pictures of the reference spiral bevel pair (DESIGN §4): flank grids, contact path, TE,
-generated fillets.
+"""Pictures of the reference spiral bevel pair (docs/reference_pairs.md): flank grids, contact path,
+TE, generated fillets.
 
 Run: ``python docs/geometry/spiral_bevel_pictures.py`` (writes ``spiral_bevel_*.png`` here).
 """

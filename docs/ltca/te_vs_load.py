@@ -104,7 +104,8 @@ def main() -> None:
         )
         lines.append(
             f"| {f} | {T:.3g} | {_num(h.te_pp_unloaded_arcsec, '.3f')} | "
-            f"{_num(h.te_pp_loaded_arcsec, '.3f')} | {h.te_pp_positions_used}/{h.n_positions} | "
+            f"{_num(h.te_pp_loaded_arcsec, '.3f')} | "
+            f"{h.te_pp_loaded_positions_used}/{h.n_positions} | "
             f"{mean:.2f} | {h.contact_ratio_loaded:.2f} | {_num(h.p_max_MPa, '.0f')} | {edge} |"
         )
     wall = time.perf_counter() - t_start

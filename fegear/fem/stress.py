@@ -1,4 +1,5 @@
-"""Stress recovery on the P2 sectors and the root stress of each tooth (DESIGN §10).
+"""Stress recovery on the P2 sectors and the root stress of each tooth (``docs/architecture.md``:
+the result model).
 
 The displacement ``u`` of a sector is quadratic on each tetrahedron (``ElementTetP2`` on the
 linear tet mesh, :mod:`fegear.fem.elasticity`), so the strain is linear on each element and
@@ -72,7 +73,7 @@ Array = NDArray[np.float64]
 RECOVERIES = ("average", "element")
 
 #: Element size on the fillets of the root-stress sectors, in modules
-#: (:func:`fegear.pipeline.run.stress_sector`). The refinement study of the FZG pair
+#: (:func:`fegear.pipeline.fields.stress_sector`). The refinement study of the FZG pair
 #: (``benchmarks/results/root_stress_refinement.md``: fillet sizes 0.4 m … 0.05 m, ratio √2)
 #: extrapolates the tension-fillet maximum to 179.5 MPa (pinion) and 170.3 MPa (gear); with the
 #: averaged recovery every level from 0.1 m on is within 2 % of that (pinion −0.6 %, gear +0.8 %

@@ -1,4 +1,4 @@
-"""Gear tooth surfaces by generation (DESIGN §4).
+"""Gear tooth surfaces by generation (``docs/reference_pairs.md``: the pairs built from them).
 
 Member frame of every family: rotation axis = z. See :mod:`fegear.geometry.surface` for the
 sign conventions (outward normals, convex-positive curvature).

@@ -1,4 +1,4 @@
-"""Face-milled spiral bevel gears generated on a cradle (DESIGN §4).
+"""Face-milled spiral bevel gears generated on a cradle (``docs/reference_pairs.md``).
 
 Sources: Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., 2004, ch. 21 "Spiral
 bevel gears"; Litvin & Zhang, NASA CR-4342 (1991) "Local synthesis and tooth contact analysis of
@@ -747,7 +747,8 @@ class SpiralBevelPair:
 
         At ``φ1 = φ2 = 0`` the mean points of the ``side`` flanks of tooth 0 of both members
         coincide on the pitch generatrix with opposite normals (the mean contact position).
-        Nominal rotation ``φ2 = (N1/N2) φ1``; the TE is ``φ2 − (N1/N2) φ1`` (DESIGN §3).
+        Nominal rotation ``φ2 = (N1/N2) φ1``; the TE is ``φ2 − (N1/N2) φ1``
+        (``docs/conventions.md``).
         """
         r = self.reports[side]
         pin, gear, _ = mesh_transforms(
@@ -851,7 +852,8 @@ def _contact(pair: SpiralBevelPair, side: Side, phi1: float, x: Array) -> tuple[
 def transmission_error(
     pair: SpiralBevelPair, side: Side, phi1: ArrayLike, substeps: int = 2
 ) -> tuple[Array, Array, Array]:
-    """Unloaded TE of the mean tooth pair (tooth 0 of both members), rad, DESIGN §3 sign.
+    """Unloaded TE of the mean tooth pair (tooth 0 of both members), rad, sign of
+    ``docs/conventions.md``.
 
     Rigid TCA by continuation from the mean contact position (φ1 = φ2 = 0); only this one tooth
     pair is considered (no edge contact, no neighbouring pairs): the full TCA is fegear.tca.

@@ -1,10 +1,10 @@
 """Gear-pair case files (TOML): schema and validation, read into a :class:`GearCase`.
 
-Units are in the key names (DESIGN §3). Unknown sections and keys are refused with the closest
-known key suggested (which catches a wrong unit suffix: ``module_in`` → ``module_mm``), missing
-required keys are refused, and every error is an :class:`~fegear.errors.InputError` naming the
-case-file field, the value and the allowed range, so that ``fegear run`` prints one line and exits
-with code 2 before any work.
+Units are in the key names (``docs/conventions.md``). Unknown sections and keys are refused with the
+closest known key suggested (which catches a wrong unit suffix: ``module_in`` → ``module_mm``),
+missing required keys are refused, and every error is an :class:`~fegear.errors.InputError` naming
+the case-file field, the value and the allowed range, so that ``fegear run`` prints one line and
+exits with code 2 before any work.
 
 The schema is declared once, as :class:`~fegear.io.schema.Section` objects (:func:`sections`):
 the validation, the defaults and the case-file reference (:func:`reference`,
@@ -46,6 +46,8 @@ from fegear.io.schema import (
     reference_markdown,
 )
 from fegear.options import ContactOptions
+from fegear.units import TORQUE_KEYS, nm_from_nmm, torque2_Nmm_from
+from fegear.units import pinion_torque_Nm as _pinion_torque_Nm
 
 __all__ = [
     "GEAR_KINDS",
@@ -65,7 +67,7 @@ __all__ = [
 GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel")
 #: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
 PARALLEL_KINDS = ("spur", "cylindrical")
-#: Fidelities of the gear pairs (DESIGN §9).
+#: Fidelities of the gear pairs (``docs/fidelity.md``).
 #: The unloaded analysis (rigid TCA only); the others are the loaded fidelities of
 #: :data:`fegear.ltca.fidelity.FIDELITIES` (tests/test_architecture.py keeps the two in step).
 UNLOADED = "tca"
@@ -80,7 +82,6 @@ N_LEVELS = 5
 
 _FIDELITY_NOTE = "fe, hertz, hybrid (loaded) or tca (unloaded)"
 _TORQUE_ALLOWED = "> 0 (positive in the driving sense)"
-_TORQUE_KEYS = ("torque2_Nm", "torque2_Nmm", "pinion_torque_Nm")
 
 
 def _design_default(cls: type, name: str) -> Any:
@@ -606,6 +607,16 @@ class GearCase:
         n1, n2 = _tooth_numbers(self.kind, self.pair)
         return n2 / n1
 
+    @property
+    def torque2_Nm(self) -> float:
+        """The gear's (member 2's) resisting torque in N·m (:mod:`fegear.units`)."""
+        return nm_from_nmm(self.torque2_Nmm)
+
+    @property
+    def pinion_torque_Nm(self) -> float:
+        """The pinion's torque in N·m that balances it (``T1 = T2 · N1/N2``, no friction)."""
+        return _pinion_torque_Nm(self.torque2_Nmm, self.ratio)
+
     def to_document(self) -> dict[str, Any]:
         """The case as a case-file document (the TOML tables as dicts, units in the keys):
         :func:`parse_gear_case` of it gives this case back (the round trip is exact)."""
@@ -679,8 +690,8 @@ class GearCase:
                     doc[section].pop(name, None)
                 else:
                     doc[section][name] = value
-            elif key in _TORQUE_KEYS:
-                for other in _TORQUE_KEYS:
+            elif key in TORQUE_KEYS:
+                for other in TORQUE_KEYS:
                     doc["load"].pop(other, None)
                 doc["load"][key] = value
             elif key == "pair":
@@ -701,7 +712,7 @@ class GearCase:
                 doc["errors"] = value
             else:
                 known = sorted(
-                    [*_REPLACE_KEYS, *_TORQUE_KEYS, "pair", "errors", "contact", "source"]
+                    [*_REPLACE_KEYS, *TORQUE_KEYS, "pair", "errors", "contact", "source"]
                 )
                 close = difflib.get_close_matches(key, known, n=1, cutoff=0.5)
                 hint = f"did you mean {close[0]!r}?" if close else ""
@@ -748,7 +759,7 @@ class GearCase:
             "load": {
                 self.load_key: self.load_value,
                 "torque2_Nmm": self.torque2_Nmm,
-                "pinion_torque_Nm": self.torque2_Nmm / self.ratio / 1000.0,
+                "pinion_torque_Nm": self.pinion_torque_Nm,
                 "speed_rpm": self.speed_rpm,
             },
             "errors": {k: getattr(self.errors, k) for k in _error_keys(self.kind)},
@@ -857,7 +868,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     mat = check_table(material_s, data.get("material", {}))
     tuning = check_table(contact_s, data.get("contact", {}))
 
-    given = [k for k in _TORQUE_KEYS if k in load]
+    given = [k for k in TORQUE_KEYS if k in load]
     if len(given) != 1:
         raise InputError(
             "load",
@@ -867,11 +878,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     key = given[0]
     value = float(load[key])
     n1, n2 = _tooth_numbers(kind, pair)
-    torque2 = {
-        "torque2_Nm": value * 1000.0,
-        "torque2_Nmm": value,
-        "pinion_torque_Nm": value * 1000.0 * n2 / n1,
-    }[key]
+    torque2 = torque2_Nmm_from(key, value, n1, n2)
     fidelity = analysis_s.value(ana, "fidelity")
     level = analysis_s.value(ana, "level")
     n_pos = analysis_s.value(ana, "n_positions")

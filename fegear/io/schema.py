@@ -2,7 +2,7 @@
 
 A case file is a TOML document of tables (sections). Each section is a :class:`Section` of
 :class:`Key` declarations: the key's type, whether it is required, its default, its allowed range
-or choices, its unit (in the key's name, DESIGN §3) and one line of meaning. The same
+or choices, its unit (in the key's name, ``docs/conventions.md``) and one line of meaning. The same
 declarations
 
 - validate a document (:func:`check_document`, :func:`check_table`): unknown sections and keys

@@ -33,7 +33,8 @@ Backends
 ``"pardiso"``
     Intel oneMKL PARDISO in Schur mode (``iparm[35] = 1``): one sparse Cholesky factorization that
     stops at the candidate block and returns :math:`S` dense. Measured 3–7× faster than ``m``
-    back-solves (DESIGN §7). Needs the ``mkl`` wheel (not on macOS arm64). See
+    back-solves (``docs/ltca/contact_formulation.md``). Needs the ``mkl`` wheel (not on macOS
+    arm64). See
     :mod:`fegear.linalg._mkl_pardiso` for the ``iparm`` settings.
 ``"superlu"``
     SciPy SuperLU, the portable fallback: factor :math:`K_{ii}` (symmetric mode, minimum degree on

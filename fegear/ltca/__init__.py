@@ -1,9 +1,11 @@
-"""Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair (DESIGN §7-§10)."""
+"""Loaded tooth contact analysis (LTCA): the loaded mesh cycle of a gear pair
+(``docs/ltca/contact_formulation.md``, ``docs/fidelity.md``)."""
 
-from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models, solve_position
+from fegear.ltca.analysis import LTCAOptions, MemberModels, build_models
 from fegear.ltca.cycle import run_ltca
 from fegear.ltca.grid import PairCells, pair_cells
-from fegear.ltca.results import LoadedCycle, LoadedPosition, PairLoad
+from fegear.ltca.position import solve_position
+from fegear.ltca.results import LoadedCycle, LoadedPosition, PairContact
 
 __all__ = [
     "LTCAOptions",
@@ -15,5 +17,5 @@ __all__ = [
     "pair_cells",
     "LoadedCycle",
     "LoadedPosition",
-    "PairLoad",
+    "PairContact",
 ]

@@ -2,7 +2,7 @@
 
 The positions are solved in chunks of ``LTCAOptions.chunk_positions`` consecutive positions. Inside
 a chunk each position starts from its predecessor (``hybrid`` cell grids and ``g_max``, and, for
-every fidelity, the contact solver's active set: :func:`fegear.ltca.analysis.solve_position`); the
+every fidelity, the contact solver's active set: :func:`fegear.ltca.position.solve_position`); the
 first position of a chunk starts from the default cells. The chunks are independent, so they run
 in parallel worker processes, forked once the models are built (the compliance operators are
 memory-mapped, the TCA and the meshes shared copy-on-write: a worker costs ~10 ms to start). The

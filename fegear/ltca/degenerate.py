@@ -27,12 +27,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from fegear.ltca.results import DEGENERATE_SHARE, MIN_CELLS_ACROSS, PairLoad
+from fegear.ltca.results import DEGENERATE_SHARE, MIN_CELLS_ACROSS, PairContact
 
 __all__ = ["position_status", "unresolved_share"]
 
 
-def unresolved_share(pairs: tuple[PairLoad, ...] | list[PairLoad]) -> float:
+def unresolved_share(pairs: tuple[PairContact, ...] | list[PairContact]) -> float:
     """The share of the torque carried by the loaded pairs the cells do not resolve."""
     return float(sum(q.load_share for q in pairs if q.in_contact and not q.resolved))
 
@@ -45,7 +45,7 @@ def position_status(phi1: float, theta: float, pairs, cell_mm) -> tuple[str, str
     phi1, theta
         The position's pinion angle and elastic lag (rad).
     pairs
-        Its :class:`~fegear.ltca.results.PairLoad` s.
+        Its :class:`~fegear.ltca.results.PairContact` s.
     cell_mm
         Per pair, the smallest cell size (mm; for the reason).
     """

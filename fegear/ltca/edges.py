@@ -4,7 +4,7 @@ A contact that reaches a boundary of a working flank (a tip, a fillet limit, a f
 singular pressure there: the flank ends abruptly, and the half-space pressure at a sharp edge
 grows like ``r^(-1/2)`` towards it (the flat-punch edge: Johnson 1985, *Contact Mechanics*,
 §5.2). Its cell values are grid-dependent (they grow as the cells shrink) and are reported as
-the edge value (:attr:`fegear.ltca.results.PairLoad.p_edge_MPa`), never as the headline.
+the edge value (:attr:`fegear.ltca.results.PairContact.p_edge_MPa`), never as the headline.
 
 **The rule** (docs/ltca/edge_reach.md). A loaded cell is *away from the edges* when it is
 farther than the edge's reach from every loaded cell on a flank boundary; its reach is the

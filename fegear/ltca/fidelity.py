@@ -13,7 +13,7 @@ results) is shared. The decisions are the members of :class:`Fidelity` (with ``m
   element wide, so its pressures and TE there are cell averages: the run warns);
 - :meth:`~Fidelity.layer_depth`: the depth of the matching layer read from the FE under every
   cell (``hybrid``: the FE is read at a depth ``d`` where the element is accurate, and the
-  half-space gives the near field above it; DESIGN §7), 0 for the others;
+  half-space gives the near field above it; ``docs/fidelity.md``), 0 for the others;
 - :meth:`~Fidelity.max_cells`: the cap on the cells of one pair;
 - ``trims``, ``warm_grids``, ``refine_rounds``: whether a position's cells are trimmed to the
   ones its neighbour's solution predicts in contact, whether it starts from its neighbour's
@@ -39,6 +39,7 @@ from fegear.errors import InputError
 from fegear.ltca.hertz_model import solve_position_hertz
 from fegear.ltca.hybrid import hybrid_compliance
 from fegear.ltca.model import cell_load_operators, member_compliance
+from fegear.ltca.position import solve_position
 
 if TYPE_CHECKING:  # the option and model types (fegear.ltca.analysis imports this module)
     from fegear.ltca.analysis import LTCAOptions, MemberModels
@@ -119,10 +120,7 @@ class FE:
         return member_compliance(models.pinion, P1) + member_compliance(models.gear, P2)
 
     def solve_position(self, tca, pos, models, torque2_Nmm, options, previous):
-        # analysis imports this module for the registry: its solver is looked up at call time
-        from fegear.ltca import analysis
-
-        return analysis.solve_position(tca, pos, models, torque2_Nmm, options.g_max_mm, previous)
+        return solve_position(tca, pos, models, torque2_Nmm, options.g_max_mm, previous)
 
 
 class Hybrid(FE):
@@ -138,7 +136,7 @@ class Hybrid(FE):
 
     def layer_depth(self, h_mm: float, module_mm: float, options: LTCAOptions) -> float:
         """``d = min(depth_elements · h, depth_max_modules · m)``: deep enough for the FE to be
-        accurate there (a few elements), shallow against the tooth (DESIGN §7)."""
+        accurate there (a few elements), shallow against the tooth (``docs/fidelity.md``)."""
         return min(options.depth_elements * h_mm, options.depth_max_modules * module_mm)
 
     def max_cells(self, models: MemberModels) -> int:

@@ -1,9 +1,9 @@
 """The ``hertz`` fidelity: multi-pair load sharing with per-pair Hertz laws and lumped compliance.
 
-The seed's multi-pair algorithm (DESIGN §9). At a position, pair ``i`` has, from the TCA, its
-smallest separation ``b_i`` (mm, along the pinion normal; 0 for the pair in contact) and the
-moment arm ``h_i`` (mm/rad) of its normal about the member-2 axis. A lag ``θ`` of member 2 gives
-it the approach ``Δ_i = θ h_i − b_i``; where ``Δ_i > 0`` it carries the force ``F_i`` solving
+The seed's multi-pair algorithm (``docs/fidelity.md``). At a position, pair ``i`` has, from the TCA,
+its smallest separation ``b_i`` (mm, along the pinion normal; 0 for the pair in contact) and the
+moment arm ``h_i`` (mm/rad) of its normal about the member-2 axis. A lag ``θ`` of member 2 gives it
+the approach ``Δ_i = θ h_i − b_i``; where ``Δ_i > 0`` it carries the force ``F_i`` solving
 
 .. math:: \\delta^H_i(F_i) + c_i F_i = \\Delta_i ,
 
@@ -39,7 +39,7 @@ At coarse FE levels the FE under-estimates the local deformation, so ``c_i`` is 
 A pair whose closest point lies on a flank edge is an edge contact: the law of the flanks'
 curvatures there gives its force (continuous with the interior), but its pressure is the edge's
 (singular), which no closed form gives: its pressures are None with the reason
-(:attr:`fegear.ltca.results.PairLoad.pressure_reason`). A pair within reach of contact that gets
+(:attr:`fegear.ltca.results.PairContact.pressure_reason`). A pair within reach of contact that gets
 no law (no curvature, a relative curvature that is not positive, no line length) makes the
 position degenerate if the lag closes it (its load would be missing from the balance).
 """
@@ -59,7 +59,7 @@ from fegear.geometry.transforms import apply_vectors, compose
 from fegear.halfspace import layout_influence, tangent_layout
 from fegear.hertz import effective_modulus, hertz_law, hertz_line
 from fegear.ltca.grid import pair_cells, separation_at, take_cells, tca_edge_names
-from fegear.ltca.results import LoadedPosition, PairLoad
+from fegear.ltca.results import LoadedPosition, PairContact
 from fegear.ltca.zone import left_out_pairs
 from fegear.tca.core import TCA
 from fegear.tca.results import ARCSEC, PositionResult
@@ -494,7 +494,7 @@ def solve_position_hertz(tca, pos, models, torque2_Nmm, E=206000.0, nu=0.3) -> L
             )
         p_val = float(p0) if not why else float("nan")
         loads.append(
-            PairLoad(
+            PairContact(
                 k=k,
                 j=j,
                 force_N=float(f),

@@ -1,10 +1,9 @@
 """The ``hybrid`` fidelity of the loaded analysis: coarse FE + closed-form half-space near field.
 
-The ``hybrid`` fidelity (DESIGN §7) changes the compliance of the cells inside each pair. The
-FE cannot resolve a patch narrower than its elements (cells finer than the P2 elements make
-``PᵀK⁻¹P`` rank-deficient), so, after Vijayakar (1991, IJNME 31, 525), the approach of cell
-``i`` is split at a matching point ``y_i = x_i + d e_i`` a depth ``d`` below it (``e_i`` the
-inward normal):
+The ``hybrid`` fidelity (``docs/fidelity.md``) changes the compliance of the cells inside each pair.
+The FE cannot resolve a patch narrower than its elements (cells finer than the P2 elements make
+``PᵀK⁻¹P`` rank-deficient), so, after Vijayakar (1991, IJNME 31, 525), the approach of cell ``i`` is
+split at a matching point ``y_i = x_i + d e_i`` a depth ``d`` below it (``e_i`` the inward normal):
 
     w_i = Q_iᵀ K⁻¹ P F  +  Σ_j [u_hs(x_i; j) − u_hs(y_i; j)] F_j      (for each member)
 
@@ -25,7 +24,7 @@ surface. The cells of each pair are refined on a grid turned to its patch's axes
 (:func:`refined_sizes`), starting from the previous position's grid; the cells predicted far
 from contact are left out of a solve, and :func:`hybrid_displacement` (the same compliance,
 loaded cells × reading cells only) checks that they stay open
-(:mod:`fegear.ltca.analysis`).
+(:mod:`fegear.ltca.position`).
 """
 
 from __future__ import annotations
@@ -140,7 +139,7 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
 
     The cost is that of the loaded × reader entries only (no square compliance; one read of
     each member's operator): it checks a solution on the cells it left out
-    (:func:`fegear.ltca.analysis.solve_position`).
+    (:func:`fegear.ltca.position.solve_position`).
     """
     asm = tca.asm
     M1 = asm.placement1(pos.phi1)

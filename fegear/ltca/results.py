@@ -1,8 +1,8 @@
 """Typed results of the loaded tooth contact analysis (frozen dataclasses).
 
 Units: force N, torque N·mm (reported N·m in summaries), pressure MPa, lengths mm, TE arcsec.
-Sign conventions (DESIGN §3): ``theta`` is the elastic lag of member 2 (rad, positive against its
-driving sense); the loaded TE is the unloaded TE minus that lag.
+Sign conventions (``docs/conventions.md``): ``theta`` is the elastic lag of member 2 (rad, positive
+against its driving sense); the loaded TE is the unloaded TE minus that lag.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ __all__ = [
     "Excluded",
     "LoadedCycle",
     "LoadedPosition",
-    "PairLoad",
+    "PairContact",
 ]
 
 Array = NDArray[np.float64]
@@ -44,8 +44,9 @@ DEGENERATE_SHARE = 0.01
 
 
 @dataclass(frozen=True)
-class PairLoad:
-    """Load on one tooth pair at one position.
+class PairContact:
+    """The contact solution of one tooth pair at one position (solver units: N·mm torque, the
+    contact point as an array). What a run reports of it is :class:`fegear.results.PairLoad`.
 
     Attributes
     ----------
@@ -130,7 +131,7 @@ class LoadedPosition:
     theta
         Elastic lag of member 2 (rad).
     pairs
-        One :class:`PairLoad` per modelled pair (in contact or not).
+        One :class:`PairContact` per modelled pair (in contact or not).
     cells
         The contact cells of each pair (same order as ``pairs``).
     pressure
@@ -162,7 +163,7 @@ class LoadedPosition:
     te_unloaded_arcsec: float
     te_loaded_arcsec: float
     theta: float
-    pairs: tuple[PairLoad, ...]
+    pairs: tuple[PairContact, ...]
     cells: tuple[PairCells, ...]
     pressure: tuple[Array, ...]
     solution: ContactSolution
@@ -222,23 +223,28 @@ class Excluded:
     ----------
     index
         Position index.
-    phi1
-        Pinion angle (rad).
+    pinion_angle_deg
+        Pinion angle φ1 (deg).
     status
         ``"lost"`` or ``"degenerate"`` (:attr:`LoadedPosition.status`).
     reason
         Why, in words.
+
+    The one record of an excluded position: the headline of the loaded analysis
+    (:class:`CycleHeadline`), the result model (:class:`fegear.results.Cycle`) and
+    ``summary.json`` (``cycle.excluded_positions``) all hold it.
     """
 
     index: int
-    phi1: float
+    pinion_angle_deg: float
     status: str
     reason: str
 
 
 @dataclass(frozen=True)
 class CycleHeadline:
-    """The cycle's headline numbers, each meaning what it says (DESIGN §10).
+    """The cycle's headline numbers, each meaning what it says (``docs/architecture.md``: the result
+    model).
 
     A value is None when nothing physical can be reported, with the reason next to it.
 
@@ -251,30 +257,31 @@ class CycleHeadline:
         than two).
     te_pp_loaded_arcsec
         Loaded TE peak-to-peak over the usable positions (status ``"ok"``), None if fewer than
-        two; ``te_pp_positions_used`` of them, ``te_pp_reason`` why None ("" otherwise).
-    excluded
+        two; ``te_pp_loaded_positions_used`` of them, ``te_pp_loaded_reason`` why None (""
+        otherwise).
+    excluded_positions
         The positions left out of it, with their reasons.
     contact_ratio_loaded
         Mean number of pairs carrying load over all positions.
     p_max_MPa
-        Largest pressure away from the flank edges (:attr:`PairLoad.p_interior_MPa`) over the
+        Largest pressure away from the flank edges (:attr:`PairContact.p_interior_MPa`) over the
         usable positions, at ``p_max_position`` on pair ``p_max_pair``; None with
         ``p_max_reason`` when no loaded cell is away from an edge on a resolved patch.
     p_max_edge_MPa
         Largest pressure at a flank edge (singular, grid-dependent) over the usable positions,
         at ``p_max_edge_position`` on pair ``p_max_edge_pair``, where it touches
         ``p_max_edge_edges``; None when no usable position has an edge contact.
-    edge_positions
+    positions_with_edge_contact
         Usable positions with a loaded pair at an edge (with an edge value, or none that the
-        fidelity can give: :attr:`PairLoad.pressure_reason`).
+        fidelity can give: :attr:`PairContact.pressure_reason`).
     """
 
     n_positions: int
     te_pp_unloaded_arcsec: float | None
     te_pp_loaded_arcsec: float | None
-    te_pp_positions_used: int
-    te_pp_reason: str
-    excluded: tuple[Excluded, ...]
+    te_pp_loaded_positions_used: int
+    te_pp_loaded_reason: str
+    excluded_positions: tuple[Excluded, ...]
     contact_ratio_loaded: float
     p_max_MPa: float | None
     p_max_reason: str
@@ -284,7 +291,7 @@ class CycleHeadline:
     p_max_edge_position: int | None
     p_max_edge_pair: tuple[int, int] | None
     p_max_edge_edges: tuple[str, ...]
-    edge_positions: tuple[int, ...]
+    positions_with_edge_contact: tuple[int, ...]
 
 
 def _none_usable(excluded: tuple[Excluded, ...]) -> str:
@@ -298,7 +305,10 @@ def _why_no_p_max(positions: tuple[LoadedPosition, ...], used: list[int]) -> str
     """The reason for a null headline p_max (no usable pressure away from the edges)."""
     if not used:
         return _none_usable(
-            tuple(Excluded(i, p.phi1, p.status, p.status_reason) for i, p in enumerate(positions))
+            tuple(
+                Excluded(i, math.degrees(p.phi1), p.status, p.status_reason)
+                for i, p in enumerate(positions)
+            )
         )
     resolved = [q for i in used for q in positions[i].pairs if q.in_contact and q.resolved]
     if resolved:  # none of them has a cell away from the edges
@@ -386,7 +396,7 @@ class LoadedCycle:
         pos = self.positions
         used = [i for i, p in enumerate(pos) if p.status == "ok"]
         excluded = tuple(
-            Excluded(i, float(p.phi1), p.status, p.status_reason)
+            Excluded(i, math.degrees(float(p.phi1)), p.status, p.status_reason)
             for i, p in enumerate(pos)
             if p.status != "ok"
         )
@@ -418,9 +428,9 @@ class LoadedCycle:
             n_positions=len(pos),
             te_pp_unloaded_arcsec=te_u,
             te_pp_loaded_arcsec=te_l,
-            te_pp_positions_used=len(used),
-            te_pp_reason=reason,
-            excluded=excluded,
+            te_pp_loaded_positions_used=len(used),
+            te_pp_loaded_reason=reason,
+            excluded_positions=excluded,
             contact_ratio_loaded=self.contact_ratio_loaded,
             p_max_MPa=None if best is None else float(best[0]),
             p_max_reason="" if best is not None else _why_no_p_max(pos, used),
@@ -430,5 +440,5 @@ class LoadedCycle:
             p_max_edge_position=None if edge is None else edge[1],
             p_max_edge_pair=None if edge is None else edge[2],
             p_max_edge_edges=() if edge is None else tuple(edge[3]),
-            edge_positions=tuple(edge_positions),
+            positions_with_edge_contact=tuple(edge_positions),
         )

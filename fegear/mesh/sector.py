@@ -1,4 +1,5 @@
-"""Tooth-sector FE meshes (DESIGN §6): ``n`` teeth plus rim, refined only where contact can happen.
+"""Tooth-sector FE meshes (``docs/mesh/README.md``): ``n`` teeth plus rim, refined only where
+contact can happen.
 
 Construction (gmsh, OpenCASCADE kernel; :mod:`fegear.mesh.sector_geometry` computes the curves):
 

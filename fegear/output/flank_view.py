@@ -18,10 +18,11 @@ same way.
 
 Writers and readers:
 
-- :func:`write_flank_vtp` — ``vtk/flank_<member>_<i>.vtp``: the loaded cells as quads in the plane
-  ``(face, profile, 0)`` with cell data ``pressure_MPa``, ``force_N``, ``tooth``, ``pair``,
-  ``edge``, and the working-surface outline as a line (cell data 0 / −1 there; ``outline`` 1);
-  field data ``pinion_angle_deg`` (the time of the ``.pvd`` series) and ``time_unit``.
+- :func:`fegear.output.flank_vtp.write_flank_vtp` — ``vtk/flank_<member>_<i>.vtp``: the
+  loaded cells as quads in the plane ``(face, profile, 0)`` with cell data ``pressure_MPa``,
+  ``force_N``, ``tooth``, ``pair``, ``edge``, and the working-surface outline as a line (cell
+  data 0 / −1 there; ``outline`` 1); field data ``pinion_angle_deg`` (the time of the ``.pvd``
+  series) and ``time_unit``.
 - :func:`plot_flank_pattern` — the bearing pattern over the cycle on one member's flank (the
   envelope of all loaded patches: the largest pressure each point of the flank saw) with the
   working-surface outline (as :func:`fegear.tca.plots.flank_outline` draws it), as a PNG.
@@ -39,6 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.results.model import PatternCentre
 from fegear.store.files import atomic_write
 
 __all__ = [
@@ -50,8 +52,6 @@ __all__ = [
     "flank_patches",
     "pattern_centre",
     "plot_flank_pattern",
-    "read_flank_vtp",
-    "write_flank_vtp",
 ]
 
 log = logging.getLogger(__name__)
@@ -133,56 +133,6 @@ class FlankPatch:
         i = np.zeros(0, dtype=np.int64)
         return FlankPatch(member, np.zeros((0, 4, 2)), np.zeros((0, 2)), z, z, i, i,
                           np.zeros(0, dtype=bool))  # fmt: skip
-
-
-@dataclass(frozen=True)
-class PatternCentre:
-    """Where the bearing pattern is on one member's flank over the cycle.
-
-    Attributes
-    ----------
-    member
-        ``"pinion"`` or ``"gear"``.
-    face_mm, profile_mm
-        Centre ``(face, profile)`` (mm; :class:`FlankFrame`): the force-weighted centroid of the
-        loaded cells over all positions (loaded fidelities), or the mean of the unloaded contact
-        points over the positions with contact, of every pair within the paint thickness
-        (6.32 µm: where two pairs close together, both) (fidelity ``tca``). None with
-        ``reason`` when there is none.
-    face_range_mm, profile_range_mm
-        ``(min, max)`` of the loaded cells (or of the path): the extent of the pattern.
-    face_name, profile_name
-        What the coordinates are.
-    weighting
-        ``"cell force"`` or ``"unloaded contact path"``.
-    reason
-        Why there is no centre ("" when there is).
-    """
-
-    member: str
-    face_mm: float | None
-    profile_mm: float | None
-    face_range_mm: tuple[float, float] | None
-    profile_range_mm: tuple[float, float] | None
-    face_name: str
-    profile_name: str
-    weighting: str
-    reason: str = ""
-
-    def as_dict(self) -> dict[str, object]:
-        """JSON-ready (``summary.json``: ``pattern``)."""
-        return {
-            "face_mm": self.face_mm,
-            "profile_mm": self.profile_mm,
-            "face_range_mm": None if self.face_range_mm is None else list(self.face_range_mm),
-            "profile_range_mm": (
-                None if self.profile_range_mm is None else list(self.profile_range_mm)
-            ),
-            "face": self.face_name,
-            "profile": self.profile_name,
-            "weighting": self.weighting,
-            "reason": self.reason,
-        }
 
 
 # --------------------------------------------------------------------------------------------
@@ -425,220 +375,6 @@ def pattern_centre(run, frames=None, patches=None) -> dict[str, PatternCentre]:
             **kw,
         )
     return out
-
-
-# --------------------------------------------------------------------------------------------
-# VTP
-# --------------------------------------------------------------------------------------------
-
-
-def write_flank_vtp(path: Path, frame: FlankFrame, patch: FlankPatch, time_deg: float) -> Path:
-    """One member's flank at one position as a ``.vtp`` (module docstring), atomically.
-
-    Written as VTK XML PolyData in ASCII (:func:`_vtp_xml`, no VTK needed; values to full
-    float64 precision), the cells ordered as VTK orders them: the outline (a line) first, then
-    the loaded quads."""
-    m = patch.quads.shape[0]
-    k = frame.outline.shape[0]
-    pts = np.zeros((k + 4 * m, 3))
-    pts[:k, :2] = frame.outline
-    pts[k:, :2] = patch.quads.reshape(-1, 2)
-    cells = {
-        "pressure_MPa": np.r_[0.0, patch.pressure_MPa],
-        "force_N": np.r_[0.0, patch.force_N],
-        "tooth": np.r_[-1, patch.tooth].astype(np.int32),
-        "pair": np.r_[-1, patch.pair].astype(np.int32),
-        "edge": np.r_[0, patch.edge.astype(np.int32)].astype(np.int32),
-        "outline": np.r_[1, np.zeros(m, np.int32)].astype(np.int32),
-    }
-    fields = {
-        "pinion_angle_deg": np.array([time_deg], dtype=np.float64),
-        "time_unit": [TIME_UNIT],
-        "member": [frame.member],
-        "x_axis": [f"face: {frame.face_name}"],
-        "y_axis": [f"profile: {frame.profile_name}"],
-        "face_ends": list(frame.face_ends),
-    }
-    text = _vtp_xml(pts, np.arange(k), np.arange(k, k + 4 * m).reshape(m, 4), cells, fields)
-    return atomic_write(path, lambda q: q.write_text(text, encoding="utf-8"))
-
-
-def read_flank_vtp(path: Path) -> tuple[FlankFrame, FlankPatch, float]:
-    """Read back :func:`write_flank_vtp`: ``(frame, patch, pinion angle deg)`` (the frame
-    without its ``bounds``). Files of earlier versions (binary, written by pyvista) are read
-    with pyvista (extra ``view``)."""
-    points, lines, polys, cd, fd = _read_vtp(Path(path))
-    member = str(fd["member"][0])
-    outline = points[lines[0], :2]
-    sel = np.asarray(cd["outline"]) == 0
-    if polys.size == 0:
-        patch = FlankPatch.empty(member)
-    else:
-        quads = points[polys][:, :, :2]
-        patch = FlankPatch(
-            member,
-            quads,
-            quads.mean(axis=1),
-            np.asarray(cd["pressure_MPa"])[sel],
-            np.asarray(cd["force_N"])[sel],
-            np.asarray(cd["tooth"])[sel].astype(np.int64),
-            np.asarray(cd["pair"])[sel].astype(np.int64),
-            np.asarray(cd["edge"])[sel] != 0,
-        )
-    ends = tuple(str(x) for x in fd["face_ends"]) if "face_ends" in fd else ("", "")
-    frame = FlankFrame(
-        member,
-        str(fd["x_axis"][0]).removeprefix("face: "),
-        str(fd["y_axis"][0]).removeprefix("profile: "),
-        outline,
-        (ends + ("", ""))[:2],
-    )
-    return frame, patch, float(fd["pinion_angle_deg"][0])
-
-
-#: VTK XML type names of the arrays written (VTK File Formats, "XML File Formats").
-_VTK_TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.int32): "Int32"}
-_NUMPY_TYPES = {
-    "Float64": np.float64,
-    "Float32": np.float32,
-    "Int32": np.int32,
-    "Int64": np.int64,
-    "UInt8": np.uint8,
-}
-
-
-def _ascii(values: np.ndarray) -> str:
-    """Numbers as text: integers as they are, floats as Python's shortest round-trip repr."""
-    return " ".join(map(repr, np.asarray(values).ravel().tolist()))
-
-
-def _vtp_xml(
-    points: Array,
-    line: NDArray[np.int_],
-    quads: NDArray[np.int_],
-    cells: dict[str, np.ndarray],
-    fields: dict[str, Any],
-) -> str:
-    """VTK XML PolyData (version 0.1, ``format="ascii"``) of one polyline ``line`` and the
-    ``quads`` on ``points``, with per-cell ``cells`` (line first) and ``fields`` (float64 arrays
-    or lists of strings; a string array in ASCII is its UTF-8 bytes as integers, each string
-    ended by 0, as VTK's own writer does)."""
-
-    def field(name: str, value: Any) -> str:
-        if isinstance(value, np.ndarray):
-            return (
-                f'<DataArray type="{_VTK_TYPES[value.dtype]}" Name="{name}" '
-                f'NumberOfTuples="{value.size}" format="ascii">{_ascii(value)}</DataArray>'
-            )
-        codes = [b for s in value for b in (*str(s).encode("utf-8"), 0)]
-        return (
-            f'<Array type="String" Name="{name}" NumberOfTuples="{len(value)}" '
-            f'format="ascii">{" ".join(map(str, codes))}</Array>'
-        )
-
-    def cell_array(name: str, value: np.ndarray) -> str:
-        return (
-            f'<DataArray type="{_VTK_TYPES[value.dtype]}" Name="{name}" '
-            f'format="ascii">{_ascii(value)}</DataArray>'
-        )
-
-    def topology(conn: np.ndarray, size: int) -> str:
-        offsets = size * np.arange(1, conn.size // size + 1) if conn.size else conn
-        return (
-            f'<DataArray type="Int64" Name="connectivity" format="ascii">{_ascii(conn)}'
-            '</DataArray>\n<DataArray type="Int64" Name="offsets" format="ascii">'
-            f"{_ascii(offsets)}</DataArray>"
-        )
-
-    empty = (
-        '<DataArray type="Int64" Name="connectivity" format="ascii"></DataArray>\n'
-        '<DataArray type="Int64" Name="offsets" format="ascii"></DataArray>'
-    )
-    n_quads = quads.shape[0]
-    return "\n".join(
-        [
-            '<?xml version="1.0"?>',
-            '<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">',
-            "<PolyData>",
-            "<FieldData>",
-            *(field(k, v) for k, v in fields.items()),
-            "</FieldData>",
-            f'<Piece NumberOfPoints="{points.shape[0]}" NumberOfVerts="0" NumberOfLines="1" '
-            f'NumberOfStrips="0" NumberOfPolys="{n_quads}">',
-            "<CellData>",
-            *(cell_array(k, v) for k, v in cells.items()),
-            "</CellData>",
-            '<Points><DataArray type="Float64" Name="Points" NumberOfComponents="3" '
-            f'format="ascii">{_ascii(points)}</DataArray></Points>',
-            f"<Verts>{empty}</Verts>",
-            f"<Lines>{topology(np.asarray(line), line.size)}</Lines>",
-            f"<Strips>{empty}</Strips>",
-            f"<Polys>{topology(np.asarray(quads).ravel(), 4)}</Polys>",
-            "</Piece>",
-            "</PolyData>",
-            "</VTKFile>",
-            "",
-        ]
-    )
-
-
-def _read_vtp(path: Path) -> tuple[Array, NDArray[np.int_], NDArray[np.int_], dict, dict]:
-    """``(points, line (one polyline's point indices, as a 1-row array), quads (q, 4), cell
-    data, field data)`` of a flank ``.vtp``: the ASCII files :func:`_vtp_xml` writes, or through
-    pyvista the binary ones of earlier versions."""
-    import xml.etree.ElementTree as ET
-
-    root = ET.parse(path).getroot()
-    arrays = root.iter("DataArray")
-    if root.get("type") != "PolyData" or any(a.get("format") != "ascii" for a in arrays):
-        return _read_vtp_pyvista(path)
-
-    def values(node: ET.Element) -> np.ndarray:
-        return np.array((node.text or "").split(), dtype=_NUMPY_TYPES[node.get("type")])
-
-    def strings(node: ET.Element) -> list[str]:
-        codes = bytes(int(c) for c in (node.text or "").split())
-        return [s.decode("utf-8") for s in codes.split(b"\0")[:-1]]
-
-    piece = root.find("PolyData/Piece")
-    fd: dict[str, Any] = {}
-    for node in _children(root.find("PolyData/FieldData")):
-        fd[node.get("Name")] = strings(node) if node.get("type") == "String" else values(node)
-    cd = {node.get("Name"): values(node) for node in _children(piece.find("CellData"))}
-    points = values(piece.find("Points/DataArray")).reshape(-1, 3)
-
-    def cells(kind: str) -> list[np.ndarray]:
-        conn = values(piece.find(f"{kind}/DataArray[@Name='connectivity']")).astype(np.int64)
-        offsets = values(piece.find(f"{kind}/DataArray[@Name='offsets']")).astype(np.int64)
-        return np.split(conn, offsets[:-1]) if offsets.size else []
-
-    line = np.array(cells("Lines"))
-    quads = np.array(cells("Polys"), dtype=np.int64).reshape(-1, 4)
-    return points, line, quads, cd, fd
-
-
-def _children(node: Any) -> list:
-    """The child elements of an XML element, none for a missing one."""
-    return [] if node is None else list(node)
-
-
-def _read_vtp_pyvista(path: Path) -> tuple[Array, NDArray[np.int_], NDArray[np.int_], dict, dict]:
-    """:func:`_read_vtp` of a binary ``.vtp`` (written by pyvista before fegear wrote ASCII)."""
-    try:
-        import pyvista as pv
-    except ImportError as exc:
-        raise ImportError(
-            f"{path} is a binary VTK file of an earlier fegear version; reading it needs "
-            "pyvista: pip install 'fegear[view]' (or run the case again)"
-        ) from exc
-    mesh = pv.read(str(path))
-    k = int(mesh.lines[0])
-    line = np.asarray(mesh.lines[1 : 1 + k], dtype=np.int64)[None, :]
-    faces = np.asarray(mesh.faces)
-    quads = faces.reshape(-1, 5)[:, 1:] if faces.size else np.zeros((0, 4), np.int64)
-    fd = {name: mesh.field_data[name] for name in mesh.field_data}
-    cd = {name: np.asarray(mesh.cell_data[name]) for name in mesh.cell_data}
-    return np.asarray(mesh.points), line, quads, cd, fd
 
 
 # --------------------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fegear.output.records import solver_record, versions
+from fegear.results.records import solver_record, versions
 from fegear.scenes.hertz_scene import HertzLevelResult, HertzScene
 from fegear.store.files import atomic_write, write_json
 

@@ -3,9 +3,9 @@ values marked as what they are.
 
 A pressure at a flank edge is singular (it grows with every refinement of the contact grid): it
 is not the contact's pressure and not a trend. The figure draws, per pair, its largest pressure
-away from the edges (:attr:`fegear.ltca.results.PairLoad.p_interior_MPa`) and, as the solid
+away from the edges (:attr:`fegear.ltca.results.PairContact.p_interior_MPa`) and, as the solid
 "position max" line, the largest of them at each position (a gap where a position has no
-interior value); the edge values (:attr:`~fegear.ltca.results.PairLoad.p_edge_MPa`) are separate
+interior value); the edge values (:attr:`~fegear.ltca.results.PairContact.p_edge_MPa`) are separate
 markers, "singular". The y range is that of the interior values; an edge value above it is drawn
 at the top edge of the plot as an upward triangle with its value written beside it.
 """

@@ -41,7 +41,7 @@ def _save(fig, path: Path) -> Path:
 
 def _title(run: GearRun) -> str:
     c = run.case
-    return f"{c.name}: T2 {c.torque2_Nmm / 1000:.0f} N·m, {c.fidelity} level {c.level}"
+    return f"{c.name}: T2 {c.torque2_Nm:.0f} N·m, {c.fidelity} level {c.level}"
 
 
 def _unloaded_path(ax, run: GearRun, which: tuple[str, ...], color: str) -> None:

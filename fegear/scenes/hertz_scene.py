@@ -68,7 +68,8 @@ CELLS_ACROSS_MINOR = (6, 8, 12, 16, 24, 32)
 ELEMENT_TO_CELL = 2.0
 #: Depth of the FE matching points of the hybrid fidelity, in FE element sizes.
 HYBRID_DEPTH_ELEMENTS = 2.0
-#: Fewer cells than this across the computed minor axis triggers a warning (DESIGN §7).
+#: Fewer cells than this across the computed minor axis triggers a warning (``docs/fidelity.md``:
+#: resolution).
 MIN_CELLS_ACROSS_MINOR = 8.0
 
 

@@ -302,9 +302,9 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
             (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.compliance"), _FE_DEPS
         ),
         # the vertex displacements of a contact sector under a run's cell loads (for the VTK
-        # files; fegear.pipeline.run)
+        # files; fegear.pipeline.fields)
         "fields": Producer(
-            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.pipeline.run"), _FE_DEPS
+            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.pipeline.fields"), _FE_DEPS
         ),
         # the tetrahedra below a flank (fegear.ltca.model)
         "layer": Producer((*_MESH_CODE, "fegear.ltca.model"), _FE_DEPS),

@@ -35,7 +35,10 @@ from typing import Any
 import numpy as np
 
 from fegear import __version__
+from fegear.results.model import GearRunResult
+from fegear.results.summary import result_from_summary
 from fegear.store.files import atomic_write, write_json
+from fegear.sweep.marker import verified_summary
 
 __all__ = [
     "TE_FLOOR_ARCSEC",
@@ -76,8 +79,9 @@ def _measure(kind: str, p: np.ndarray) -> np.ndarray:
     return p[:, 2]
 
 
-def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
-    """Key results of one run from its ``summary.json`` document.
+def key_results(result: GearRunResult | Mapping[str, Any]) -> dict[str, Any]:
+    """Key results of one run from its result model (or its ``summary.json`` document, read
+    into the model: :func:`fegear.results.result_from_summary`).
 
     Returns
     -------
@@ -87,42 +91,38 @@ def key_results(doc: Mapping[str, Any]) -> dict[str, Any]:
         ``pattern_position_mm`` (see the module docstring), ``pattern_extent_mm``
         (``[min, max]`` of the contact points), ``pattern_measure``, ``pattern_weighting``.
     """
-    c = doc["cycle"]
-    kind = doc["kind"]
+    r = result if isinstance(result, GearRunResult) else result_from_summary(result)
+    c = r.cycle
     pts, w = [], []
-    for pos in doc["positions"]:
-        for q in pos["pairs"]:
-            cp = q.get("contact_point_mm")
-            if cp is None:
+    for pos in r.positions:
+        for q in pos.pairs:
+            if q.contact_point_mm is None:
                 continue
-            f = q.get("force_N")
-            if f is not None and f <= 0:
+            if q.force_N is not None and q.force_N <= 0:
                 continue
-            pts.append(cp)
-            w.append(1.0 if f is None else float(f))
-    loaded = any(q.get("force_N") is not None for p in doc["positions"] for q in p["pairs"])
+            pts.append(q.contact_point_mm)
+            w.append(1.0 if q.force_N is None else float(q.force_N))
+    loaded = any(q.force_N is not None for p in r.positions for q in p.pairs)
     pos_mm = extent = None
     if pts:
-        s = _measure(kind, np.asarray(pts, dtype=float))
+        s = _measure(r.kind, np.asarray(pts, dtype=float))
         wa = np.asarray(w)
         pos_mm = float(np.sum(wa * s) / np.sum(wa))
         extent = [float(s.min()), float(s.max())]
     return {
-        "te_pp_unloaded_arcsec": _finite(c.get("te_pp_unloaded_arcsec")),
-        "te_pp_loaded_arcsec": _finite(c.get("te_pp_loaded_arcsec")),
-        "contact_ratio_loaded": _finite(c.get("contact_ratio_loaded")),
-        "p_max_MPa": _finite(c.get("p_max_MPa")),
+        "te_pp_unloaded_arcsec": _finite(c.te_pp_unloaded_arcsec),
+        "te_pp_loaded_arcsec": _finite(c.te_pp_loaded_arcsec),
+        "contact_ratio_loaded": _finite(c.contact_ratio_loaded),
+        "p_max_MPa": _finite(c.p_max_MPa),
         "pattern_position_mm": pos_mm,
         "pattern_extent_mm": extent,
-        "pattern_measure": _MEASURE.get(kind, _MEASURE["spur"])[0],
+        "pattern_measure": _MEASURE.get(r.kind, _MEASURE["spur"])[0],
         "pattern_weighting": "pair force" if loaded else "unloaded contact points",
     }
 
 
 def _read_summary(folder: Path) -> dict[str, Any] | None:
     """The item's summary.json, only if it is the complete one its marker vouches for."""
-    from fegear.sweep.run import verified_summary
-
     return verified_summary(folder)
 
 

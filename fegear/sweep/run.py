@@ -40,9 +40,7 @@ from __future__ import annotations
 
 import contextlib
 import copy
-import hashlib
 import itertools
-import json
 import logging
 import math
 import os
@@ -60,6 +58,9 @@ from typing import Any
 from fegear import __version__
 from fegear.errors import BackendUnavailable, FegearError, InputError
 from fegear.io.gear_case import FIDELITIES, GEAR_KINDS, N_LEVELS, GearCase
+from fegear.sweep.marker import MARKER, digest, read_marker, verified_summary
+from fegear.sweep.output import comparison_error, write_sweep_json, write_sweep_outputs
+from fegear.units import TORQUE_KEYS
 
 __all__ = [
     "GridAxis",
@@ -79,11 +80,9 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: Name of the per-item marker file, written last inside the item folder.
-MARKER = "sweep_item.json"
 _MAX_AXIS = 1000
 _MAX_ITEMS = 10000
 _NOT_SWEEPABLE = ("case",)  # kind / name / description of the base case stay as they are
-_TORQUE_KEYS = ("torque2_Nm", "torque2_Nmm", "pinion_torque_Nm")
 
 Value = int | float | str
 Progress = Callable[["ItemResult", int, int], None]
@@ -391,8 +390,8 @@ def build_items(
                 table = doc.setdefault(sec, {})
                 if not isinstance(table, dict):
                     raise InputError(sec, table, f"a TOML table [{sec}]", f"--grid {a.spec}")
-                if sec == "load" and key in _TORQUE_KEYS:
-                    for other in _TORQUE_KEYS:  # the swept torque replaces the case's torque
+                if sec == "load" and key in TORQUE_KEYS:
+                    for other in TORQUE_KEYS:  # the swept torque replaces the case's torque
                         table.pop(other, None)
                 table[key] = v
             doc["case"]["name"] = name
@@ -413,49 +412,11 @@ def build_items(
 # --------------------------------------------------------------------------------------------
 
 
-def _read_marker(folder: Path) -> dict[str, Any] | None:
-    try:
-        doc = json.loads((folder / MARKER).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) else None
-
-
-def _digest(path: Path) -> str | None:
-    """SHA-256 of a file (None if it cannot be read)."""
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return None
-
-
-def verified_summary(folder: Path) -> dict[str, Any] | None:
-    """The item's ``summary.json`` document, or None unless it is the one its marker vouches
-    for: the marker (written last) records the SHA-256 of the summary, and the file read now
-    must have it and parse (a summary truncated or edited after the item finished is not
-    trusted)."""
-    m = _read_marker(folder)
-    if m is None or not m.get("summary_sha256"):
-        return None
-    path = folder / "summary.json"
-    try:
-        data = path.read_bytes()
-    except OSError:
-        return None
-    if hashlib.sha256(data).hexdigest() != m["summary_sha256"]:
-        return None
-    try:
-        doc = json.loads(data.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) else None
-
-
 def is_done(folder: Path, item: SweepItem) -> bool:
     """Whether ``folder`` holds the finished, complete results of ``item``: a marker with its
     fingerprint and a summary.json that is the one the marker vouches for
     (:func:`verified_summary`)."""
-    m = _read_marker(folder)
+    m = read_marker(folder)
     return (
         m is not None
         and m.get("fingerprint") == item.fingerprint()
@@ -539,7 +500,7 @@ def run_item(
                 "base_case": item.base,
                 "params": item.params,
                 "fingerprint": item.fingerprint(),
-                "summary_sha256": _digest(tmp / "summary.json"),
+                "summary_sha256": digest(tmp / "summary.json"),
                 "fegear": __version__,
                 "seconds": seconds,
                 "finished_unix": time.time(),
@@ -670,8 +631,6 @@ def run_sweep(
     FegearError
         The scheduler cannot be reached, or another sweep holds the folder.
     """
-    from fegear.sweep.output import comparison_error, write_sweep_json, write_sweep_outputs
-
     items = tuple(items)
     if workers < 1:
         raise InputError("--workers", workers, "an integer >= 1")

@@ -1,4 +1,4 @@
-"""Unloaded tooth contact analysis (TCA) over the mesh cycle, multi-pair (DESIGN §5).
+"""Unloaded tooth contact analysis (TCA) over the mesh cycle, multi-pair (``docs/tca/README.md``).
 
 Use :func:`run_tca` on an :class:`~fegear.assembly.Assembly`; results are
 :class:`CycleResult` / :class:`PositionResult`; :class:`SeparationGrid` is the contact grid of

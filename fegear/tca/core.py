@@ -1,4 +1,4 @@
-"""Unloaded multi-pair TCA over the mesh cycle (DESIGN §5).
+"""Unloaded multi-pair TCA over the mesh cycle (``docs/tca/README.md``).
 
 For each position ``φ1`` and each candidate pair (pinion tooth ``k``, gear tooth ``j``) the
 *angular gap* ``θ(u1, v1)`` (:mod:`.solve`) is computed on a grid of the pinion flank, its minimum
@@ -6,9 +6,9 @@ is refined on the exact surfaces (a box-constrained quadratic-model pattern sear
 least-squares quadratic, Newton step, stencil shrink), and the gear flank EDGES (tip and face ends)
 are searched against the pinion surface as well (edge contact of the gear), so that contact on any
 flank boundary is found. The pair's closing rotation is the smaller of the two; the unloaded TE is
-``−min over pairs`` (DESIGN §3: ``Δφ2 = φ2 − (N1/N2) φ1``, negative = the gear lags). Then the
-separation field along the pinion normal (the LTCA contact grid), the contact ellipse (paint
-thickness and Hertz, :mod:`fegear.hertz`) and the edge flags follow.
+``−min over pairs`` (``docs/conventions.md``: ``Δφ2 = φ2 − (N1/N2) φ1``, negative = the gear lags).
+Then the separation field along the pinion normal (the LTCA contact grid), the contact ellipse
+(paint thickness and Hertz, :mod:`fegear.hertz`) and the edge flags follow.
 
 Pairs: ``m ∈ pair_offsets`` gives pinion tooth ``k = −s1 m`` and gear tooth ``j = −s2 m``
 (``s_i`` the driving senses), so ``m = 0`` is in contact at ``φ1 = 0`` and ``m = +1`` is the next

@@ -21,8 +21,8 @@ def reference_phase(pinion, gear, assembly: Assembly, options: TCAOptions | None
     """``phase2`` (rad) of the reference position: the ERROR-FREE pair in contact at ``φ1 = 0``.
 
     The TE of any assembly built with this phase is measured from the error-free contact
-    position (DESIGN §3: ``φ2⁰`` is the gear angle of that contact at ``φ1⁰ = 0``), so an
-    error-free conjugate pair has TE 0 and an error shows as the change it causes.
+    position (``docs/conventions.md``: ``φ2⁰`` is the gear angle of that contact at ``φ1⁰ = 0``), so
+    an error-free conjugate pair has TE 0 and an error shows as the change it causes.
     """
     nom = assembly.without_errors()
     opt = options or TCAOptions()

@@ -62,6 +62,7 @@ from ..errors import InputError
 from ..geometry.surface import finite_difference_curvatures
 from ..geometry.transforms import apply_vectors
 from ..hertz import HertzPoint, effective_modulus, hertz_point, paint_ellipse
+from ..units import NMM_PER_NM
 
 __all__ = [
     "LINE_CONTACT_RATIO",
@@ -212,7 +213,7 @@ def normal_force(pinion_torque_Nm: float, point: Array, normal: Array, axis1) ->
     the pinion torque ``T1`` (N·m) at ``point`` (mm) with ``normal``; ``axis1 = (O_1, e_1)``."""
     o1, e = axis1
     arm = abs(float(np.dot(np.cross(e, np.asarray(point) - o1), normal)))
-    return 1e3 * pinion_torque_Nm / arm
+    return NMM_PER_NM * pinion_torque_Nm / arm  # N·mm over mm
 
 
 @dataclass(frozen=True)

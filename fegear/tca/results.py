@@ -1,7 +1,7 @@
 """Typed TCA results (frozen dataclasses; arrays with shapes and units documented).
 
-Sign conventions: DESIGN §3. ``θ`` is a rotation of member 2 AGAINST its driving sense (a lag,
-rad) — the unknown of :mod:`fegear.contact` — and the unloaded TE is ``−θ*`` with ``θ*`` the
+Sign conventions: ``docs/conventions.md``. ``θ`` is a rotation of member 2 AGAINST its driving sense
+(a lag, rad) — the unknown of :mod:`fegear.contact` — and the unloaded TE is ``−θ*`` with ``θ*`` the
 rotation that closes the smallest gap over all pairs, relative to the reference position (the
 error-free pair in contact at ``φ1 = 0``). No array holds NaN: entries without meaning are 0 and
 masked by a boolean array next to them.

@@ -469,7 +469,7 @@ def iso_root_stress(name: str) -> tuple[dict, dict, float, float]:
 
 def root_run(name: str = "helical_15", n_positions: int = 16) -> RootRun:
     """fegear's root stress over a cycle (``hybrid`` level 0, the stress sectors with refined
-    fillets: :func:`fegear.pipeline.run.displacements`) beside :func:`iso_root_stress`. The
+    fillets: :func:`fegear.pipeline.fields.displacements`) beside :func:`iso_root_stress`. The
     FE value is the largest over the positions and the loaded teeth: ISO's σF0 is the nominal
     stress of the most unfavourable load position, which a helical tooth meets somewhere in the
     cycle; ``n_positions`` samples it."""

@@ -61,7 +61,7 @@ torque on the pair: the teeth bend); the tooth carries the whole load highest on
 little before, where its root stress peaks. ISO's σF0 is the stress of that load case (the whole
 load at the outer point of single contact), so fegear's value is the peak over positions stepping
 back from the rigid point, from the stress sectors under the solved cell forces
-(:func:`fegear.pipeline.run.displacements`). Measured (hybrid, 200 N·m): level 0 pinion 178.0 /
+(:func:`fegear.pipeline.fields.displacements`). Measured (hybrid, 200 N·m): level 0 pinion 178.0 /
 183.1 MPa (0.972), gear 169.0 / 177.7 MPa (0.951); level 1 178.6 (0.975) and 168.8 (0.950).
 
 ``python -m fegear.validation.iso6336_root`` prints the rows.
@@ -426,8 +426,8 @@ def fe_root_stress(
     then one stress solve per member. Returns ``({"pinion": …, "gear": …}, run)`` with
     ``run = (pair, asm, models, cycle, phi2)``."""
     from fegear.ltca import LTCAOptions, build_models, run_ltca
+    from fegear.pipeline.fields import displacements
     from fegear.pipeline.pair import build_pair
-    from fegear.pipeline.run import displacements
     from fegear.tca.results import ARCSEC
 
     t0 = time.perf_counter()
@@ -493,7 +493,7 @@ def rows(levels: tuple[int, ...] = (0, 1), fidelity: str = "hybrid", case=None) 
     case = case or _fzg_case()
     ref = fzg_reference(case)
     runs = [fe_root_stress(fidelity, lv, case)[0] for lv in levels]
-    T = case.torque2_Nmm / 1000.0
+    T = case.torque2_Nm
     out = []
     for name, point in (("pinion", "D"), ("gear", "B")):
         f, s0 = ref[name]

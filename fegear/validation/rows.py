@@ -323,7 +323,7 @@ def fzg_rows(runs: Sequence[PitchPointRun], case=None) -> list[Row]:
     """The FZG rows (line Hertz p_max at mid-face, ISO 6336-1 c'th) from pitch-point runs."""
     case = case or _case("fzg_spur.toml")
     h, c = fzg_reference(case)
-    T = case.torque2_Nmm / 1000.0
+    T = case.torque2_Nm
     where = f"FZG type C, {T:g} N·m on the gear, at the pitch point (φ1 = {runs[0].phi1_deg:.3f}°)"
 
     def note(r: PitchPointRun) -> str:
@@ -517,7 +517,7 @@ def bevel_rows(b: BevelParabola) -> list[Row]:
 # Seed trend: TE, contact ratio and patch size grow with the load
 # --------------------------------------------------------------------------------------------
 
-#: The seed face gear at its light, moderate and heavy loads (DESIGN §4).
+#: The seed face gear at its light, moderate and heavy loads (``docs/reference_pairs.md``).
 TREND_CASES = (
     "face_gear_load_light.toml",
     "face_gear_load_moderate.toml",

@@ -1,0 +1,184 @@
+"""The PNG pictures of a gear run: ``te.png``, ``load_share.png``, ``p_max.png``,
+``root_stress.png`` (loaded fidelities), and the unloaded TE of the TCA. Their titles quote the
+headlines of the result model (:class:`fegear.results.GearRunResult`), never recompute them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from fegear.output.pattern_plot import plot_loaded_pattern, plot_unloaded_pattern
+from fegear.pipeline.run import GearRun
+from fegear.results.model import GearRunResult
+from fegear.store.files import atomic_write
+
+__all__ = ["loaded_plots", "tca_plots"]
+
+
+def _num(x: float | None, fmt: str) -> str:
+    return "not reported" if x is None else format(x, fmt)
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: Path) -> Path:
+    plt = _plt()
+    fig.tight_layout()
+    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
+    plt.close(fig)
+    return p
+
+
+def _title(run: GearRun) -> str:
+    c = run.case
+    return f"{c.name}: T2 {c.torque2_Nm:.0f} N·m, {c.fidelity} level {c.level}"
+
+
+def _plot_te(out: Path, run: GearRun, result: GearRunResult) -> Path:
+    plt = _plt()
+    c = run.cycle
+    deg = np.degrees(c.phi1)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    ax.plot(deg, c.te_unloaded_arcsec, "o-", ms=3, label="unloaded")
+    ax.plot(deg, c.te_loaded_arcsec, "s-", ms=3, label="loaded")
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("TE (arcsec)")
+    h = result.cycle
+    ax.set_title(
+        f"{_title(run)}\nTE p-p unloaded {_num(h.te_pp_unloaded_arcsec, '.2f')}, loaded "
+        f"{_num(h.te_pp_loaded_arcsec, '.2f')} arcsec "
+        f"(over {h.te_pp_loaded_positions_used} of {h.n_positions} positions)",
+        fontsize=9,
+    )
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, out / "te.png")
+
+
+def _per_pair(run: GearRun, attr: str) -> dict[int, np.ndarray]:
+    """``{pinion tooth: (n,) values}`` (NaN where the pair is not modelled or not loaded)."""
+    c = run.cycle
+    teeth = sorted({q.k for p in c.positions for q in p.pairs})
+    out = {k: np.full(len(c.positions), np.nan) for k in teeth}
+    for i, p in enumerate(c.positions):
+        for q in p.pairs:
+            if q.force_N > 0:
+                out[q.k][i] = getattr(q, attr)
+    return out
+
+
+def _plot_load_share(out: Path, run: GearRun, result: GearRunResult) -> Path:
+    plt = _plt()
+    deg = np.degrees(run.cycle.phi1)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for k, v in _per_pair(run, "load_share").items():
+        ax.plot(deg, np.nan_to_num(v), "o-", ms=3, label=f"pinion tooth {k:+d}")
+    ax.set_xlabel("pinion angle φ1 (deg)")
+    ax.set_ylabel("load share (torque fraction)")
+    ax.set_ylim(-0.05, 1.05)
+    cr = result.cycle.contact_ratio_loaded
+    ax.set_title(f"{_title(run)}\nloaded contact ratio {_num(cr, '.2f')}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, out / "load_share.png")
+
+
+def _plot_p_max(out: Path, run: GearRun, result: GearRunResult) -> Path:
+    """``p_max.png`` (:mod:`fegear.output.p_max_plot`: the values away from the edges as lines,
+    the singular edge values marked apart)."""
+    from fegear.output.p_max_plot import save_p_max
+
+    h = result.cycle
+    edge = (
+        f"; at the edges {h.p_max_edge_MPa:.0f} MPa (singular)"
+        if h.p_max_edge_MPa is not None
+        else ""
+    )
+    title = f"{_title(run)}\ncycle p_max away from the edges {_num(h.p_max_MPa, '.0f')} MPa{edge}"
+    return save_p_max(out / "p_max.png", run.cycle, title, _save)
+
+
+def _one_tooth(mf, phi1_deg: np.ndarray, pitch_deg: float):
+    """The root stress of one tooth over its whole passage through the mesh, pieced together
+    from the teeth of the cycle: tooth ``t`` at ``φ1`` is tooth 0 at ``φ1 − σ t p`` (``p`` the
+    pinion's angular pitch; ``σ = ±1``, the sense that makes the loaded stretches of the teeth
+    one: the smaller spread). Returns ``(x_deg, tension, compression)`` sorted by ``x``."""
+    teeth = mf.root_teeth
+    best = None
+    for sigma in (1.0, -1.0):
+        xs = [phi1_deg - sigma * t * pitch_deg for t in teeth]
+        loaded = [
+            x[[any(r.tooth == t and r.loaded for r in row) for row in mf.root]]
+            for t, x in zip(teeth, xs, strict=True)
+        ]
+        centres = [float(np.mean(v)) for v in loaded if v.size]
+        spread = float(np.ptp(centres)) if centres else 0.0
+        if best is None or spread < best[0]:
+            best = (spread, xs)
+    x = np.concatenate(best[1])
+    ten = np.concatenate([mf.root_series(t) for t in teeth])
+    com = np.concatenate([mf.root_series(t, "compression_MPa") for t in teeth])
+    o = np.argsort(x)
+    return x[o], ten[o], com[o]
+
+
+def _plot_root_stress(out: Path, run: GearRun) -> Path:
+    """``root_stress.png``: per member, the tension-fillet maximum principal stress and the
+    compression-fillet minimum principal stress of one tooth over its passage through the mesh
+    (:func:`_one_tooth`), against the pinion angle of the cycle."""
+    plt = _plt()
+    c = run.cycle
+    deg = np.degrees(c.phi1)
+    pitch = 360.0 / run.assembly.n1
+    fig, axes = plt.subplots(1, len(run.members), figsize=(11, 4), squeeze=False)
+    for ax, mf in zip(axes[0], run.members, strict=True):
+        if not mf.root_teeth:
+            ax.set_title(f"{mf.name}: no loaded position", fontsize=9)
+            continue
+        x, ten, com = _one_tooth(mf, deg, pitch)
+        ax.plot(x, ten, "o-", ms=3, color="tab:red", label="tension fillet, max principal")
+        ax.plot(x, com, "s--", ms=3, color="tab:blue", label="compression fillet, min principal")
+        ax.axhline(0.0, color="gray", lw=0.5)
+        ax.set_xlabel("pinion angle of the tooth's passage φ1 (deg)")
+        ax.set_ylabel("root stress (MPa)")
+        top = float(np.nanmax(ten))
+        ax.set_title(
+            f"{mf.name}: one tooth through the mesh; max {top:.0f} MPa "
+            f"(fillet elements {mf.fillet_mm:.3g} mm)",
+            fontsize=9,
+        )
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(_title(run), fontsize=9)
+    return _save(fig, out / "root_stress.png")
+
+
+def tca_plots(out: Path, run: GearRun) -> list[Path]:
+    """``te.png`` (the unloaded TE) and ``bearing_pattern.png`` (paint thickness) of an unloaded
+    run."""
+    from fegear.tca.plots import plot_te
+
+    r, name = run.tca, run.case.name
+    paths = [atomic_write(out / "te.png", lambda q: plot_te({name: r}, q,
+                          title=f"{name}: unloaded TE (TCA)"))]  # fmt: skip
+    paths.append(plot_unloaded_pattern(out, run))
+    return paths
+
+
+def loaded_plots(out: Path, run: GearRun, result: GearRunResult) -> list[Path]:
+    """``te.png``, ``load_share.png``, ``p_max.png``, ``bearing_pattern.png`` and, with the
+    root stress, ``root_stress.png`` of a loaded run (``result``: its model, whose headlines the
+    titles quote)."""
+    paths = [_plot_te(out, run, result), _plot_load_share(out, run, result),
+             _plot_p_max(out, run, result), plot_loaded_pattern(out, run)]  # fmt: skip
+    if run.members and any(mf.root for mf in run.members):
+        paths.append(_plot_root_stress(out, run))
+    return paths
