@@ -17,7 +17,8 @@ cold on 2 cores, the sector meshes and compliance operators are then cached).
 (:mod:`fegear.sweep`); ``fegear cache info | clear [--kind K]`` shows or empties the
 mesh/operator cache (:mod:`fegear.store.cache`: the per-user cache folder, or ``$FEGEAR_CACHE``);
 ``fegear plot FOLDER [--member gear|pinion]`` draws the bearing pattern over the cycle on a
-member's flank from a run's flank views.
+member's flank from a run's flank views. ``fegear export-ccx CASE`` writes the case as CalculiX
+decks (:mod:`fegear.export.command`).
 
 The command is a layer over the Python API (:mod:`fegear.api`): ``fegear run`` is
 ``fegear.run(case, ...)`` then ``result.write(out)``, with the progress and the report printed.
@@ -154,6 +155,9 @@ def _parser() -> argparse.ArgumentParser:
                     help="whose flank (default: gear)")  # fmt: skip
     pl.add_argument("--png", help="the PNG (default: FOLDER/bearing_pattern_<member>_flank.png)")
     pl.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    from fegear.export.command import add_parser as add_export
+
+    add_export(sub)
     return p
 
 
@@ -544,7 +548,7 @@ def main(argv: list[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
-        if args.command in ("run", "sweep"):
+        if args.command in ("run", "sweep", "export-ccx"):
             from fegear.store.cache import check_cache_root
 
             check_cache_root()  # an unusable FEGEAR_CACHE is refused before any work
@@ -556,6 +560,10 @@ def main(argv: list[str] | None = None) -> int:
             return _cache(args)
         if args.command == "plot":
             return _plot(args)
+        if args.command == "export-ccx":
+            from fegear.export.command import run as export_ccx
+
+            return export_ccx(args)
     except InputError as exc:
         print(f"fegear: error: {exc}", file=sys.stderr)
         return 2

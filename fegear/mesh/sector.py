@@ -337,6 +337,7 @@ def _build(
     min_sicn: float,
     path: Path,
     fillet_mm: float | None = None,
+    refine: tuple = ((), None),
 ) -> dict[str, object]:
     """Build and mesh the sector, writing ``path``; returns the diagnostics.
 
@@ -350,7 +351,7 @@ def _build(
     t0 = time.perf_counter()
     for alg2, alg3 in attempts:
         try:
-            diag = _attempt(fr, n_teeth, level, zone, alg2, alg3, path, fillet_mm)
+            diag = _attempt(fr, n_teeth, level, zone, alg2, alg3, path, fillet_mm, refine)
         except _AttemptFailed as exc:
             log.warning("sector mesh: %s", exc)
             failures.append(str(exc))
@@ -378,6 +379,7 @@ def _attempt(
     alg3: int,
     path: Path,
     fillet_mm: float | None = None,
+    refine: tuple = ((), None),
 ) -> dict[str, object]:
     import gmsh
 
@@ -500,15 +502,31 @@ def _attempt(
         fd.setNumber(t2, "SizeMax", h_coarse)
         fd.setNumber(t2, "DistMin", d_fil)
         fd.setNumber(t2, "DistMax", d_fil + 2.5 * (h_coarse - h_fil))
+        fields = [t1, t2]
+        boxes, h_ref = refine
+        if boxes:  # the boxes of a chosen size (sector_mesh's refine, refine_mm)
+            rp = _zone_points(fr, boxes, 0.5 * h_ref, n_teeth)
+            rtags = [occ.addPoint(*p) for p in rp]
+            occ.synchronize()
+            f3 = fd.add("Distance")
+            fd.setNumbers(f3, "PointsList", rtags)
+            t3 = fd.add("Threshold")
+            fd.setNumber(t3, "InField", f3)
+            fd.setNumber(t3, "SizeMin", h_ref)
+            fd.setNumber(t3, "SizeMax", h_coarse)
+            fd.setNumber(t3, "DistMin", 0.5 * h_ref)
+            fd.setNumber(t3, "DistMax", 0.5 * h_ref + 2.5 * (h_coarse - h_ref))
+            fields.append(t3)
+            diag.update(refine_points=len(rp), refine_mm=h_ref)
         fmin = fd.add("Min")
-        fd.setNumbers(fmin, "FieldsList", [t1, t2])
+        fd.setNumbers(fmin, "FieldsList", fields)
         fd.setAsBackgroundMesh(fmin)
         for k, v in {
             "Mesh.MeshSizeExtendFromBoundary": 0,
             "Mesh.MeshSizeFromPoints": 0,
             "Mesh.MeshSizeFromCurvature": 0,
             "Mesh.MeshSizeMax": h_coarse,
-            "Mesh.MeshSizeMin": min(0.5 * h_fine, h_fil),
+            "Mesh.MeshSizeMin": min(0.5 * h_fine, h_fil, 0.5 * (refine[1] or h_fine)),
             "Mesh.ElementOrder": 1,
             "Mesh.Optimize": 1,
         }.items():
@@ -612,6 +630,8 @@ def sector_mesh(
     min_sicn: float = 0.03,
     fillet_mm: float | None = None,
     side: Side = "drive",
+    refine: Sequence[FlankZone] = (),
+    refine_mm: float | None = None,
 ) -> SectorMesh:
     """Mesh (or load from the cache) a sector of ``n_teeth`` teeth of ``member``.
 
@@ -642,6 +662,11 @@ def sector_mesh(
         ``benchmarks/results/root_stress_refinement.md``).
     side
         Working flank side of the default zone (``"drive"`` or ``"coast"``).
+    refine, refine_mm
+        Flank boxes meshed at ``refine_mm`` (mm) besides the zone, the size growing away from
+        them with the same slope (the full-FE decks of :mod:`fegear.export`: elements of a
+        chosen size around the contact patches of one position); both enter the cache key
+        only when given.
 
     Raises
     ------
@@ -676,6 +701,15 @@ def sector_mesh(
             raise InputError("mesh.fillet_mm", fillet_mm, "a finite size > 0 (mm)")
         params["fillet_mm"] = float(fillet_mm)
         params["fillet_triangles"] = FILLET_TRIANGLES
+    refine = tuple(refine)
+    if refine:
+        if refine_mm is None or not (np.isfinite(refine_mm) and refine_mm > 0.0):
+            raise InputError("refine_mm", refine_mm, "a finite size > 0 (mm) with refine boxes")
+        for z in refine:
+            if not 0 <= z.tooth < n_teeth:
+                raise InputError("mesh.refine.tooth", z.tooth, f"in 0..{n_teeth - 1}")
+        params["refine"] = [[z.tooth, z.side, list(z.u), list(z.v)] for z in refine]
+        params["refine_mm"] = float(refine_mm)
 
     # the entry (fegear.store.cache.cached_record): the .msh, then the JSON of the diagnostics
     # that makes it valid; the key holds the code of fegear.mesh and fegear.geometry and gmsh's
@@ -684,7 +718,19 @@ def sector_mesh(
         diag: dict[str, object] = {}
 
         def write(tmp: Path) -> None:
-            diag.update(_build(fr, n_teeth, level, zone, algorithm, min_sicn, tmp, fillet_mm))
+            diag.update(
+                _build(
+                    fr,
+                    n_teeth,
+                    level,
+                    zone,
+                    algorithm,
+                    min_sicn,
+                    tmp,
+                    fillet_mm,
+                    (refine, refine_mm),
+                )  # fmt: skip
+            )
 
         entry.write(".msh", write)
         return diag

@@ -1,0 +1,102 @@
+"""Full-FE decks of fegear's problems for CalculiX (and Abaqus), and their results read back.
+
+- :func:`export_ccx`: a case (the Hertz scene, or a gear pair at chosen positions) as
+  ready-to-run ``.inp`` decks (:mod:`fegear.export.hertz_deck`, :mod:`fegear.export.gear_deck`);
+- :func:`~fegear.export.ccx_run.run_ccx`: runs ``ccx`` on one, with its wall time and memory;
+- :func:`~fegear.export.ccx_results.read_results`: load shares, p_max, patch semi-axes, TE.
+
+``docs/calculix.md`` documents the decks and how they compare with fegear.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+from fegear.errors import InputError
+from fegear.export.ccx_results import CcxPair, CcxResult, read_results
+from fegear.export.ccx_run import CcxMissing, CcxRun, find_ccx, run_ccx
+from fegear.export.deck import Deck
+
+__all__ = [
+    "CcxMissing",
+    "CcxPair",
+    "CcxResult",
+    "CcxRun",
+    "Deck",
+    "export_ccx",
+    "find_ccx",
+    "position_angle",
+    "read_results",
+    "run_ccx",
+    "DEFAULT_GEAR_ELEMENT_MM",
+]
+
+#: Default contact element size of a gear deck (mm).
+DEFAULT_GEAR_ELEMENT_MM = 0.5
+
+
+def position_angle(case, index: int) -> float:
+    """Pinion angle (rad) of position ``index`` of the case's cycle of ``n_positions``
+    (``−π/N1 + 2π index / (N1 n)``: the positions of ``fegear run``)."""
+    from fegear.pipeline.pair import build_pair
+
+    n = case.n_positions
+    if not (isinstance(index, int) and 0 <= index < n):
+        raise InputError("position", index, f"an index in 0..{n - 1} (the case's n_positions)")
+    n1 = build_pair(case).assembly.n1
+    return -math.pi / n1 + 2 * math.pi / n1 * index / n
+
+
+def export_ccx(
+    case,
+    out: str | Path,
+    element_mm: float | None = None,
+    phi1: Sequence[float] = (),
+    reach_mm: float | None = None,
+    level: int | None = None,
+) -> list[Path]:
+    """Write the CalculiX decks of ``case`` into ``out``: ``<job>.inp`` and its record
+    ``<job>.json`` each. Returns the ``.inp`` paths.
+
+    Parameters
+    ----------
+    case
+        A :class:`~fegear.case.HertzCase` (one deck) or a
+        :class:`~fegear.io.gear_case.GearCase` (one deck per pinion angle of ``phi1``).
+    element_mm
+        Contact element size (mm). Default: the Hertz scene's level (twice its cell size, as
+        fegear meshes it); :data:`DEFAULT_GEAR_ELEMENT_MM` for gears.
+    phi1
+        Gear pairs: pinion angles (rad; :func:`position_angle` of a cycle index).
+    reach_mm
+        Gear pairs: :func:`fegear.export.gear_deck.gear_deck`'s reach (default
+        :data:`~fegear.export.gear_deck.DEFAULT_REACH_MM`).
+    level
+        Gear pairs: sector mesh level away from the contact (default: the case's).
+    """
+    from fegear.case import HertzCase
+
+    if isinstance(case, HertzCase):
+        from fegear.export.hertz_deck import hertz_deck
+        from fegear.scenes.hertz_scene import (
+            CELLS_ACROSS_MINOR,
+            ELEMENT_TO_CELL,
+            hertz_reference,
+        )
+
+        if phi1:
+            raise InputError("positions", list(phi1), "none for the Hertz scene")
+        if element_mm is None:
+            b = hertz_reference(case.scene).b_mm
+            element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[case.level]
+        return [hertz_deck(case.scene, element_mm, name=f"{case.name}_{element_mm:.3g}mm")
+                .write(out)]  # fmt: skip
+    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck
+
+    if not phi1:
+        raise InputError("positions", [], "at least one position of a gear pair")
+    h = DEFAULT_GEAR_ELEMENT_MM if element_mm is None else element_mm
+    reach = DEFAULT_REACH_MM if reach_mm is None else reach_mm
+    return [gear_deck(case, p, h, reach_mm=reach, level=level).write(out) for p in phi1]
