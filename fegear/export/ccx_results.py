@@ -78,6 +78,14 @@ class CcxPair:
         Slave nodes with a positive pressure.
     nodal_force_N
         ``Σ CPRESS × tributary area``: the normal force again, from the pressures.
+    edge_contact
+        The patch reaches a border of either working flank (tip, fillet limit, face end).
+    p_interior_MPa
+        Largest nodal pressure away from the flank borders (fegear's rule,
+        :mod:`fegear.ltca.edges`: farther than ``max(3 b, 2 h)`` from every loaded node on a
+        border, ``b`` the patch's semi-minor axis, ``h`` the deck's contact element size);
+        None when no loaded node is that far, or its pressure is below the pair's mean
+        pressure (the tail of a patch sitting on the edge).
     """
 
     k: int
@@ -91,6 +99,8 @@ class CcxPair:
     semi_minor_mm: float
     n_active: int
     nodal_force_N: float
+    edge_contact: bool = False
+    p_interior_MPa: float | None = None
 
 
 @dataclass(frozen=True)
@@ -243,14 +253,12 @@ def _tributary(faces: Array, xyz: dict[int, Array]) -> dict[int, float]:
 
 def _patch(nodes, xyz, press, weights, mirror: bool) -> tuple[float, float, float, float, int]:
     """``(p_max, p_peak, semi_major, semi_minor, n_active)`` of the nodes' pressures."""
-    ids = [n for n in nodes if press.get(n, 0.0) > 0.0]
+    ids = [n for n in nodes if press.get(n, 0.0) > 0.0 and weights.get(n, 0.0) > 0.0]
     if not ids:
         return 0.0, 0.0, 0.0, 0.0, 0
     P = np.array([xyz[n] for n in ids])
     p = np.array([press[n] for n in ids])
-    w = np.array([weights.get(n, 0.0) for n in ids])
-    keep = w > 0.0  # nodes of the surface's faces only
-    P, p, w = P[keep], p[keep], w[keep]
+    w = np.array([weights[n] for n in ids])
     if mirror:  # the Hertz quarter model: both symmetry planes x = 0, y = 0
         sx = np.array([1.0, -1.0, 1.0, -1.0])
         sy = np.array([1.0, 1.0, -1.0, -1.0])
@@ -261,6 +269,31 @@ def _patch(nodes, xyz, press, weights, mirror: bool) -> tuple[float, float, floa
     uv = d @ vt[:2].T  # the patch's tangent plane
     pm = measure_patch(uv, p * w, w)
     return float(p.max()), pm.p_peak, pm.semi_major, pm.semi_minor, len(ids)
+
+
+def _interior(nodes, xyz, press, weights, border, b: float, h: float):
+    """``(edge_contact, p_interior)`` of a pair (:class:`CcxPair`): loaded nodes within ``h / 2``
+    of a border node are on the edge; the interior is farther than ``max(3 b, 2 h)`` from them.
+    """
+    from scipy.spatial import cKDTree
+
+    ids = [n for n in nodes if press.get(n, 0.0) > 0.0 and weights.get(n, 0.0) > 0.0]
+    if not ids:
+        return False, None
+    P = np.array([xyz[n] for n in ids])
+    p = np.array([press[n] for n in ids])
+    w = np.array([weights[n] for n in ids])
+    on_edge = np.zeros(len(ids), dtype=bool)
+    if len(border):
+        B = np.array([xyz[n] for n in border if n in xyz])
+        on_edge = cKDTree(B).query(P)[0] <= 0.5 * h
+    if not on_edge.any():
+        return False, float(p.max())
+    far = cKDTree(P[on_edge]).query(P)[0] > max(3.0 * b, 2.0 * h)
+    mean = float(np.sum(p * w) / np.sum(w))
+    if not far.any() or p[far].max() < mean:
+        return True, None
+    return True, float(p[far].max())
 
 
 def read_results(job: str | Path) -> CcxResult:
@@ -308,6 +341,8 @@ def read_results(job: str | Path) -> CcxResult:
         pmax, ppeak, sa, sb, nact = _patch(nodes, xyz, press, w, hertz and
                                            rec["modelled_fraction"] < 1.0)  # fmt: skip
         nodal = float(sum(press.get(n, 0.0) * w[n] for n in nodes if n in w))
+        border = rec.get("edge_nodes", {}).get(p["slave"], [])
+        edge, p_int = _interior(nodes, xyz, press, w, border, sb, float(rec["element_mm"]))
         if hertz:
             torque, share = 0.0, 1.0
         else:
@@ -326,6 +361,8 @@ def read_results(job: str | Path) -> CcxResult:
                 semi_minor_mm=sb,
                 n_active=nact,
                 nodal_force_N=nodal,
+                edge_contact=edge,
+                p_interior_MPa=p_int,
             )  # fmt: skip
         )
     if hertz:

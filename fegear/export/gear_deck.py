@@ -208,12 +208,16 @@ def gear_deck(
     rim = gear.face_nodes("support") + 1 + n1
     out.write(nset_lines("GEAR_RIM", rim))
     out.write(f"*RIGID BODY, NSET=GEAR_RIM, REF NODE={rp}, ROT NODE={rot}\n")
-    pairs, slave_faces = [], {}
+    pairs, slave_faces, edge_nodes = [], {}, {}
     for k, j in here.pairs:
         k, j = int(k), int(j)
         s, m = f"S_pinion_zone_{k + c}", f"S_gear_zone_{j + c}"
         pairs.append({"k": k, "j": j, "slave": s, "master": m})
         slave_faces[s] = (pin.face_triangles(f"zone_{k + c}") + 1).tolist()
+        # the borders of both working flanks: a patch reaching one is an edge contact
+        edge_nodes[s] = np.concatenate(
+            [pin.border_nodes(f"flank_{k + c}") + 1, gear.border_nodes(f"flank_{j + c}") + 1 + n1]
+        ).tolist()
     out.write(contact_cards([(p["slave"], p["master"]) for p in pairs], penalty_E * case.E_MPa))
     fixed = [("PINION_HELD", 1, 3, None), ("RP_GEAR", 1, 3, None), ("ROT_GEAR", 1, 2, None)]
     out.write("*STEP\n*STATIC\n")
@@ -252,6 +256,7 @@ def gear_deck(
         "preload_rad": theta_pre,
         "pairs": pairs,
         "slave_faces": slave_faces,
+        "edge_nodes": edge_nodes,
         "lever_max_mm": lever,
         "left_out": left,
         "ref_nodes": {"RP_GEAR": rp, "ROT_GEAR": rot},

@@ -35,7 +35,11 @@ from fegear.export.inp import Tet10Body, tet10_body, write_body
 from fegear.mesh.hertz_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh
 from fegear.scenes.hertz_scene import HertzScene, hertz_reference
 
-__all__ = ["hertz_deck", "barrel_projection"]
+__all__ = ["hertz_deck", "barrel_projection", "PRELOAD_APPROACH"]
+
+#: The first step's prescribed approach of the axle, in Hertz approaches (the answer does not
+#: depend on it; near the final one, the second step needs fewer Newton iterations).
+PRELOAD_APPROACH = 0.7
 
 
 def barrel_projection(Rx: float, Ry: float):
@@ -158,8 +162,9 @@ def hertz_deck(
     K = penalty_E * E
     slave, master = "S_block_zone", "S_roller_zone"
     out.write(contact_cards([(slave, master)], K))
-    # step 1: the axle pushed down by a quarter of Hertz's approach (contact established)
-    pre = 0.25 * ref.approach_mm
+    # step 1: the axle pushed down by part of Hertz's approach (contact established near the
+    # final patch: fewer Newton iterations in step 2)
+    pre = PRELOAD_APPROACH * ref.approach_mm
     out.write("*STEP\n*STATIC\n")
     out.write(boundary_lines(fixed + [("RP_AXLE", 3, 3, -pre)], op_new=False))
     out.write("*END STEP\n")

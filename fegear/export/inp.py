@@ -84,6 +84,15 @@ class Tet10Body:
             raise MeshError(f"surface {name!r} of {self.name}: no face of {of!r} selected")
         return replace(self, faces=faces)
 
+    def border_nodes(self, name: str) -> IntArray:
+        """Sorted node indices on the border of a surface (the corners and mid-edge nodes of
+        the face edges that belong to one of its faces only)."""
+        t = self.face_triangles(name)
+        e = np.concatenate([t[:, [0, 1, 3]], t[:, [1, 2, 4]], t[:, [2, 0, 5]]])
+        key = np.sort(e[:, :2], axis=1)
+        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        return np.unique(e[count[inv.ravel()] == 1])
+
     def face_triangles(self, name: str) -> IntArray:
         """``(k, 6)`` node indices of a surface's faces: corners then mid-edges (outward order
         of CalculiX's face numbering)."""
