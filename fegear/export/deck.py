@@ -4,7 +4,7 @@ A deck (:class:`Deck`) is the ``.inp`` text plus a JSON record of what the reade
 (:mod:`fegear.export.ccx_results`) needs to turn the results back into fegear's quantities: the
 contact pairs' surface names, the reference nodes, the frame, the load.
 
-Contact (``docs/calculix/README.md``): face-to-face penalty contact (``TYPE=SURFACE TO
+Contact (``docs/calculix.md``): face-to-face penalty contact (``TYPE=SURFACE TO
 SURFACE``), frictionless, linear pressure-overclosure of slope ``K`` (MPa/mm). The penalty lets
 the surfaces overlap by ``p / K``: with the default ``K = 50 E / mm`` (CalculiX's own default for
 node-to-face penalty) that is 0.15 µm at 1500 MPa, against 5-10 µm of elastic approach in the

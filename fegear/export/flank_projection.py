@@ -8,9 +8,10 @@ elastic approach there, and as much as the separation that decides whether a sec
 load. On the exact surface the quadratic face follows it to ``O(h³)``.
 
 The closest points are those of :func:`fegear.mesh.sector_geometry.flank_distance` (Gauss-Newton
-on the exact flank from the nearest of a sample grid) on the member the sector is meshed from
-(the unmodified solid of a member with flank modifications: its deck's flanks are those of the
-solid, the modification is not in the deck; ``docs/calculix.md``).
+on the exact flank from the nearest of a sample grid) on the member itself: a member with flank
+modifications (crowning, reliefs) is meshed as its unmodified solid
+(:func:`fegear.mesh.sector.sector_mesh`), and its flank nodes moved onto the modified flank put
+the modification, some µm, into the deck.
 """
 
 from __future__ import annotations
@@ -32,10 +33,8 @@ _BATCH = 2000
 def flank_projection(
     member, side: str, tooth: int, rim_modules: float = 3.0
 ) -> Callable[[Array], Array]:
-    """``f(points (q, 3)) -> (q, 3)``: closest points on the working ``side`` flank of member
-    tooth ``tooth`` (member frame, mm)."""
-    if hasattr(member, "mesh_member"):
-        member = member.mesh_member()
+    """``f(points (q, 3)) -> (q, 3)``: closest points on the working ``side`` flank (with its
+    modifications) of member tooth ``tooth`` (member frame, mm)."""
     fr = sector_frame(member, rim_modules)
 
     def project(x: Array) -> Array:

@@ -11,19 +11,21 @@ The same problem as fegear's loaded analysis at that position:
   the origin, the pinion placed by the assembly (installation errors included) at the TCA's
   closed position (the first pair touching, the others open by their separations).
 - **Supports.** The pinion's bore (face gear: blank base) and both sector cuts fixed, as fegear
-  clamps them (the pinion held); the gear's bore/base and cuts tied by a kinematic coupling
-  (``*COUPLING``, ``*KINEMATIC``, all six DOFs) to the reference node ``RP_GEAR`` on the axis,
-  which may only turn about ``z``: fegear's rigid rotation ``θ`` of member 2.
-- **Load.** The resisting torque ``T2`` on ``RP_GEAR`` against the gear's driving sense, in the
+  clamps them (the pinion held); the gear's bore/base and cuts made one rigid body
+  (``*RIGID BODY``) with the reference node ``RP_GEAR`` on the axis, held, and the rotation
+  node ``ROT_GEAR`` (CalculiX: its translations are the body's rotations), free only in ``z``:
+  fegear's rigid rotation ``θ`` of member 2. (CalculiX 2.20's ``*KINEMATIC`` coupling carries
+  translations only, DOFs 1-3.)
+- **Load.** The resisting torque ``T2`` on ``ROT_GEAR`` against the gear's driving sense, in the
   two steps of :mod:`fegear.export.deck` (a small prescribed lag that closes the first pair by
   about a micrometre, then the torque).
 - **Contact.** One ``*CONTACT PAIR`` per tooth pair that can touch (a valid pair whose
   separation at this position is below ``reach_mm``): the pinion's working flank (slave)
   against the gear's (master), penalty, frictionless.
 - **Output.** The contact force and moment per pair (``*CONTACT PRINT``; the deck's frame puts
-  the moment about ``z`` equal to the pair's torque on the gear axis), the displacements of
-  ``GEAR_RIM`` (the coupled nodes: their rigid rotation is ``θ``), the contact pressures
-  (``*CONTACT FILE``). :mod:`fegear.export.ccx_results` reads them.
+  the moment about ``z`` equal to the pair's torque on the gear axis), the displacement of
+  ``ROT_GEAR`` (the rotation ``θ``), the displacements (``*NODE FILE``) and the contact
+  pressures (``*CONTACT FILE``). :mod:`fegear.export.ccx_results` reads them.
 
 Pairs whose separation exceeds ``reach_mm`` are not in contact pairs: the deck's record keeps
 their angular separations, and the reader flags a solved lag that would have closed one.
