@@ -40,10 +40,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 CASES = ROOT / "cases"
 OUT = ROOT / "benchmarks" / "results"
-#: FZG positions (pinion angle, deg): the pitch point (the pair (0, 0) touches the pinion at
-#: its operating pitch radius 36.6 mm: interpolated from the TCA's contact radii at -6.25° and
-#: -5°) and the middle of the two-pair zone (both pairs in interior contact from 1.25° to 10°)
-FZG_POSITIONS = {"pitch point": -5.74, "two pairs": 5.0}
+#: FZG's two-pair position (pinion angle, deg): the middle of the two-pair zone (both pairs in
+#: interior contact from 1.25° to 10° by the rigid TCA); the pitch point (one pair) comes from
+#: :func:`fegear.validation.rows.pitch_point_phi1`
+FZG_TWO_PAIRS_DEG = 5.0
 HERTZ_LADDER = (0.45, 0.32, 0.24, 0.16, 0.12)
 FZG_LADDER = (0.7, 0.5, 0.35)
 
@@ -178,8 +178,14 @@ def hertz_rows(work: Path, threads: int, ladder) -> dict:
 
 
 def fzg_rows(work: Path, threads: int, ladder) -> dict:
-    out = {}
-    for label, phi in FZG_POSITIONS.items():
+    from fegear.api import load_case
+    from fegear.pipeline.pair import build_pair
+    from fegear.validation.rows import fzg_reference, pitch_point_phi1
+
+    case = load_case(CASES / "fzg_spur.toml")
+    pitch = round(math.degrees(pitch_point_phi1(build_pair(case))), 3)
+    out = {"line_hertz_p0_MPa": fzg_reference(case)[0].p_H_MPa}
+    for label, phi in (("pitch point", pitch), ("two pairs", FZG_TWO_PAIRS_DEG)):
         rows = {"phi1_deg": phi, "ccx": [], "fegear": []}
         for h in ladder:
             rows["ccx"].append(ccx_row(CASES / "fzg_spur.toml", work, threads, h, phi))
@@ -236,7 +242,11 @@ def markdown(doc: dict) -> str:
               "pressure away from the flank borders (fegear's rule, `fegear.ltca.edges`; — "
               "where none is reported), in brackets the largest overall. Lag θ: the gear's "
               "elastic rotation (µrad); loaded TE = unloaded TE − θ.", ""]  # fmt: skip
+        L += [f"ISO 6336-2 line Hertz at the pitch point: p_H {doc['fzg']['line_hertz_p0_MPa']:.0f}"
+              " MPa.", ""]  # fmt: skip
         for label, rows in doc["fzg"].items():
+            if not isinstance(rows, dict):
+                continue
             L += [f"### {label} (φ1 = {rows['phi1_deg']}°)", "",
                   "| solver | contact elements (mm) | DOFs | load shares (k, j): share | "
                   "p_max interior (overall) MPa | semi-minor mm | lag µrad | loaded TE arcsec | "
@@ -274,7 +284,77 @@ def markdown(doc: dict) -> str:
                     f"{r['warm_s']:.1f} warm | {r['peak_MB']:.0f} |"
                 )
             L.append("")
+    L += summary(doc)
     return "\n".join(L) + "\n"
+
+
+def _settled(rows: list[dict], keys, tol: float) -> dict | None:
+    """The first of ``rows`` (coarse to fine) from which on every row is within ``tol`` in
+    every ``keys`` (a coarse row within it by chance, with a finer one outside, does not
+    count)."""
+    for i, r in enumerate(rows):
+        if all(abs(q[k]) <= tol for q in rows[i:] for k in keys):
+            return r
+    return None
+
+
+def _shares(pairs: list[dict]) -> dict:
+    return {(p["k"], p["j"]): p["load_share"] for p in pairs}
+
+
+def _dev(ref: dict, shares: dict) -> float:
+    """Largest difference of two sets of load shares (a pair missing from one: share 0)."""
+    return max(abs(ref.get(k, 0.0) - shares.get(k, 0.0)) for k in set(ref) | set(shares))
+
+
+def summary(doc: dict) -> list[str]:
+    """The comparisons at equal accuracy, computed from the rows."""
+    L = ["## At equal accuracy", ""]
+    if "hertz_scene" in doc:
+        h = doc["hertz_scene"]
+        ok = [r for r in h["ccx"] if "result" in r]
+        for what, keys, tol in (
+            ("p0 within 1 % from this size on", ("e_p0",), 0.01),
+            ("p0, a and b within 2 % from this size on", ("e_p0", "e_a", "e_b"), 0.02),
+        ):
+            cc = _settled(sorted(ok, key=lambda r: -r["element_mm"]), keys, tol)
+            ff = _settled(sorted(h["fegear"], key=lambda r: r["level"]), keys, tol)
+            if cc and ff:
+                L.append(f"- Hertz scene, {what}: CalculiX {cc['element_mm']} mm in "
+                         f"{cc['ccx_s']:.0f} s and {cc['peak_MB']:.0f} MB; fegear hybrid level "
+                         f"{ff['level']} in {ff['cold_s']:.1f} s cold ({ff['warm_s']:.1f} s "
+                         f"warm) and {ff['peak_MB']:.0f} MB: {cc['ccx_s'] / ff['cold_s']:.0f}x "
+                         f"the cold time.")  # fmt: skip
+            elif ff and ok:
+                fin = min(ok, key=lambda r: r["element_mm"])
+                errs = ", ".join(f"{k[2:]} {_pct(fin[k])}" for k in keys)
+                L.append(f"- Hertz scene, {what}: not reached by CalculiX within its ladder (at "
+                         f"{fin['element_mm']} mm, {fin['ccx_s']:.0f} s: {errs}); fegear hybrid "
+                         f"level {ff['level']}: {ff['cold_s']:.1f} s cold.")  # fmt: skip
+    for label, rows in doc.get("fzg", {}).items():
+        if not isinstance(rows, dict):
+            continue
+        ok = sorted((r for r in rows["ccx"] if "result" in r), key=lambda r: -r["element_mm"])
+        if not ok:
+            continue
+        fin = ok[-1]["result"]
+        ref = _shares(fin["pairs"])
+
+        step = [f"{r['element_mm']} mm: {_dev(ref, _shares(r['result']['pairs'])):.4f}"
+                for r in ok[:-1]]  # fmt: skip
+        L.append(f"- FZG {label}: CalculiX's load shares against its finest size "
+                 f"({ok[-1]['element_mm']} mm): " + (", ".join(step) or "one size only")
+                 + f"; its lag {1e6 * fin['theta_rad']:.1f} µrad.")  # fmt: skip
+        for r in rows["fegear"]:
+            sh = {(p["k"], p["j"]): p["share"] for p in r["pairs"]}
+            lag = 100 * (r["theta"] / fin["theta_rad"] - 1)
+            L.append(f"  fegear {r['fidelity']} level {r['level']}: load shares within "
+                     f"{_dev(ref, sh):.4f}, lag {lag:+.1f} %, in "
+                     f"{r['cold_s']:.1f} s cold ({r['warm_s']:.1f} s warm), {r['peak_MB']:.0f} "
+                     f"MB; CalculiX at {ok[-1]['element_mm']} mm: {ok[-1]['ccx_s']:.0f} s, "
+                     f"{ok[-1]['peak_MB']:.0f} MB ({ok[-1]['ccx_s'] / r['cold_s']:.0f}x the "
+                     f"cold time).")  # fmt: skip
+    return L + [""]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -286,7 +366,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--skip-hertz", action="store_true")
     ap.add_argument("--skip-fzg", action="store_true")
     ap.add_argument("--out", default=str(OUT / "calculix"), help="report path without extension")
+    ap.add_argument("--report-only", action="store_true",
+                    help="rewrite the .md from the .json of the last run (no runs)")  # fmt: skip
     args = ap.parse_args(argv)
+    out = Path(args.out)
+    if args.report_only:
+        text = markdown(json.loads(out.with_suffix(".json").read_text()))
+        out.with_suffix(".md").write_text(text)
+        print(text)
+        return 0
     from fegear.export import CcxMissing, find_ccx
 
     try:
@@ -312,7 +400,6 @@ def main(argv: list[str] | None = None) -> int:
     if not args.skip_fzg:
         ladder = [float(x) for x in args.fzg.split(",")] if args.fzg else FZG_LADDER
         doc["fzg"] = fzg_rows(work, args.threads, ladder)
-    out = Path(args.out)
     out.with_suffix(".json").write_text(json.dumps(doc, indent=1))
     text = markdown(doc)
     out.with_suffix(".md").write_text(text)
