@@ -272,7 +272,7 @@ def gear_deck(
         "mesh_cache_hit": all(bool(sm.diagnostics.get("cache_hit")) for sm in sectors),
         "arcsec_rad": ARCSEC,
     }
-    log.info("gear deck %s: %d nodes, %d C3D10, %d contact pairs", name, n_nodes,
-             record["n_elements"], len(pairs))  # fmt: skip
     job = name or f"{case.name}_phi{round(math.degrees(pos.phi1) * 1000):+d}"
+    log.info("gear deck %s: %d nodes, %d C3D10, %d contact pairs", job, n_nodes,
+             record["n_elements"], len(pairs))  # fmt: skip
     return Deck(name=job, text=out.getvalue(), record=record)
