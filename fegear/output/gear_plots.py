@@ -8,6 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
+from fegear.output.figure import pyplot as _plt
+from fegear.output.figure import run_title as _title
+from fegear.output.figure import save_png as _save
 from fegear.output.pattern_plot import plot_loaded_pattern, plot_unloaded_pattern
 from fegear.pipeline.run import GearRun
 from fegear.results.model import GearRunResult
@@ -18,28 +21,6 @@ __all__ = ["loaded_plots", "tca_plots"]
 
 def _num(x: float | None, fmt: str) -> str:
     return "not reported" if x is None else format(x, fmt)
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path: Path) -> Path:
-    plt = _plt()
-    fig.tight_layout()
-    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
-    plt.close(fig)
-    return p
-
-
-def _title(run: GearRun) -> str:
-    c = run.case
-    return f"{c.name}: T2 {c.torque2_Nm:.0f} N·m, {c.fidelity} level {c.level}"
 
 
 def _plot_te(out: Path, run: GearRun, result: GearRunResult) -> Path:

@@ -15,33 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
+from fegear.output.figure import pyplot as _plt
+from fegear.output.figure import run_title as _title
+from fegear.output.figure import save_png as _save
 from fegear.pipeline.run import GearRun
 from fegear.store.files import atomic_write
 from fegear.tca.plots import axis_label, draw_ellipses
 
 __all__ = ["plot_loaded_pattern", "plot_unloaded_pattern"]
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path: Path) -> Path:
-    plt = _plt()
-    fig.tight_layout()
-    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
-    plt.close(fig)
-    return p
-
-
-def _title(run: GearRun) -> str:
-    c = run.case
-    return f"{c.name}: T2 {c.torque2_Nm:.0f} N·m, {c.fidelity} level {c.level}"
 
 
 def _unloaded_path(ax, run: GearRun, which: tuple[str, ...], color: str) -> None:
