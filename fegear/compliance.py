@@ -37,7 +37,7 @@ import logging
 import time
 import weakref
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import NamedTuple
@@ -60,6 +60,7 @@ __all__ = [
     "load_operator",
     "candidate_operator",
     "body_compliance",
+    "boundary_normals",
 ]
 
 log = logging.getLogger(__name__)
@@ -127,6 +128,14 @@ class CandidateOperator:
         Whether it was read from the on-disk cache.
     backend
         The sparse direct backend used ("pardiso", "superlu"), or "cache".
+    projection
+        ``T`` (n_dofs × n_dofs, CSR) for an operator on the normal DOFs of surface nodes
+        (:func:`candidate_operator` with ``normals``): row ``3s`` of a normal node ``s`` is its
+        unit normal ``n_s`` on the DOFs ``3s..3s+2``, rows ``3s+1, 3s+2`` are empty, every other
+        row is the identity's. None: the Cartesian DOFs themselves.
+    tangential
+        Sorted DOFs ``3s+1, 3s+2`` of the normal nodes (full numbering): in this basis they are
+        the nodes' tangential components, never loaded or read.
     """
 
     dofs: np.ndarray
@@ -136,6 +145,21 @@ class CandidateOperator:
     backend: str
     cols: np.ndarray
     fixed: np.ndarray
+    projection: sp.csr_matrix | None = None
+    tangential: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    @property
+    def load_support(self) -> np.ndarray:
+        """Sorted DOFs (full numbering) a load may sit on: the load DOFs, the tangential DOFs
+        of their nodes that :attr:`projection` folds onto the normal, and the clamped DOFs."""
+        return np.union1d(np.union1d(self.cols, self.tangential), self.fixed)
+
+    def project(self, M: sp.spmatrix) -> sp.spmatrix:
+        """``M`` (n_dofs × n, loads or readings in the full Cartesian numbering) in the
+        operator's DOF basis: unchanged without a :attr:`projection`, else ``T M``, the
+        Cartesian components at each normal node folded onto its normal (``n · (·)``) and the
+        tangential ones dropped (:func:`candidate_operator`)."""
+        return M if self.projection is None else self.projection @ M
 
     @cached_property
     def _row_map(self) -> tuple[np.ndarray, np.ndarray]:
@@ -471,6 +495,7 @@ def candidate_operator(
     cache_key: dict | None = None,
     load_dofs: np.ndarray | None = None,
     groups: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
+    normals: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> CandidateOperator:
     """``(K^{-1})_{cf}`` on the candidate DOFs ``c = dofs`` and the load DOFs ``f = load_dofs``
     (full numbering; default all of ``dofs``; clamped ones dropped from both; ``f ⊂ c``).
@@ -494,9 +519,38 @@ def candidate_operator(
     alone (what the ``fe`` and ``hertz`` fidelities read), and each group's block is an entry of
     its own (``(K⁻¹)_{read_g, load_g}`` depends on ``K`` alone), so the fidelities share what
     they have in common and only a missing block is ever computed.
+
+    ``normals`` (``(s, n)``: scalar DOFs ``(p,)`` of surface nodes and their unit normals
+    ``(p, 3)``, :func:`boundary_normals`) puts the operator on the normal DOFs of those nodes:
+    at each node the Cartesian DOFs are turned into ``(n, t₁, t₂)`` by an orthonormal
+    ``R_s = [n t₁ t₂]`` (``u = R u'``, ``K' = Rᵀ K R``, the same body), and of those nodes only
+    the normal DOF ``n · u`` is a candidate or load DOF. A cell load ``P`` is then applied
+    through its normal components ``n_s · P_s`` (:meth:`CandidateOperator.project`) and the
+    approach is read the same way, so that
+
+    .. math::
+
+        C = (T P)^T \\, G'\\, (T P), \\qquad G'_{st} = n_s^T (K^{-1})_{st}\\, n_t ,
+
+    the normal-load, normal-displacement influence coefficients of the LTCA literature
+    (e.g. Conry & Seireg 1973; Vijayakar 1991): the tangential components a cell force has
+    at a node (the angle between the node's normal and the cell's force direction, a fraction
+    of a degree to a few degrees) are not applied, nor their tangential displacements read.
+    The dense work falls by the cube of the load DOFs (a third of them): measured on the seed
+    face gear (``docs/ltca/normal_operator.md``). The nodes must be free or clamped in all
+    three directions.
     """
     c = np.intersect1d(np.asarray(dofs, dtype=np.int64), body.free)
     f = c if load_dofs is None else np.intersect1d(np.asarray(load_dofs, np.int64), body.free)
+    rot = None if normals is None else _normal_basis(body, *normals)
+    if rot is not None:  # only the normal DOF of each normal node stays a candidate
+        c = np.setdiff1d(c, rot.tangential, assume_unique=True)
+        f = np.setdiff1d(f, rot.tangential, assume_unique=True)
+        if groups is not None:
+            groups = [
+                (np.setdiff1d(fg, rot.tangential), np.setdiff1d(lg, rot.tangential))
+                for fg, lg in groups
+            ]
     if not np.all(np.isin(f, c)):
         raise InputError("load_dofs", f"{int(np.sum(~np.isin(f, c)))} outside dofs", "within dofs")
     groups_ = None if groups is None else _groups(c, f, body.free, groups)
@@ -517,32 +571,47 @@ def candidate_operator(
         return used
 
     base = {"body": cache_key, "E": body.E, "nu": body.nu, "n_free": int(body.free.size)}
+    stiffness = _Stiffness(body, rot)
     if groups_ is None:
-        params = {"kind": "inverse_block_v1", **base, "dofs": c}
+        params = {"kind": "inverse_block_v1", **base, "dofs": c, **_turned(rot, c)}
         if f.size < c.size:
             params.update(kind="inverse_columns_v1", cols=f)
         G, hit = _cached_block(
             params,
             cache_key is not None,
-            lambda: inverse_columns(body.K, pos, np.isin(c, f), backend=solver()),
+            lambda: inverse_columns(stiffness(), pos, np.isin(c, f), backend=solver()),
         )
         arrays, hits = [G], [hit]
     else:
         # G_ff is the entry a square operator on f alone is (the ``fe`` fidelity's): every
         # fidelity on the same flanks shares it; each group's block is an entry of its own, so
         # that a block missing from the cache is the only one computed
+        # With few candidate DOFs in all (the normal DOFs of the flanks and layers), one Schur
+        # complement onto all of them gives G_ff and every group's block at once (one sparse
+        # factorisation instead of one per block); it is made when G_ff is missing, and the
+        # group blocks missing from the cache are cut from it.
+        union: list[np.ndarray] = []
+
+        def square() -> np.ndarray:
+            if c.size > UNION_MAX_DOFS:
+                return inverse_columns(stiffness(), pos[rf], np.ones(f.size, bool), solver())
+            union.append(inverse_columns(stiffness(), pos, np.isin(c, f), backend=solver()))
+            return np.ascontiguousarray(union[0][rf])
+
         G_ff, hit = _cached_block(
-            {"kind": "inverse_block_v1", **base, "dofs": f},
+            {"kind": "inverse_block_v1", **base, "dofs": f, **_turned(rot, f)},
             cache_key is not None,
-            lambda: inverse_columns(body.K, pos[rf], np.ones(f.size, bool), backend=solver()),
+            square,
         )
         arrays, hits = [G_ff], [hit]
-        for (fg, lg), (_, cols_g) in zip(groups_, layout[1:], strict=True):
+        for (fg, lg), (rows_g, cols_g) in zip(groups_, layout[1:], strict=True):
             cg = np.union1d(fg, lg)
 
-            def off(cg=cg, fg=fg, cols_g=cols_g) -> np.ndarray:
+            def off(cg=cg, fg=fg, rows_g=rows_g, cols_g=cols_g) -> np.ndarray:
+                if union:
+                    return np.ascontiguousarray(union[0][np.ix_(rows_g, cols_g)])
                 return inverse_off_block(
-                    body.K,
+                    stiffness(),
                     np.searchsorted(body.free, cg),
                     np.isin(cg, fg),
                     G_ff[np.ix_(cols_g, cols_g)],
@@ -550,6 +619,7 @@ def candidate_operator(
                 )
 
             params = {"kind": "inverse_off_block_v1", **base, "load": fg, "read": lg}
+            params.update(_turned(rot, cg))
             B, hit = _cached_block(params, cache_key is not None, off)
             arrays.append(B)
             hits.append(hit)
@@ -574,7 +644,120 @@ def candidate_operator(
         backend="cache" if hit else used,
         cols=f,
         fixed=fixed,
+        projection=None if rot is None else rot.projection,
+        tangential=np.zeros(0, np.int64) if rot is None else rot.tangential,
     )
+
+
+class _NormalBasis(NamedTuple):
+    """The turned DOF basis of :func:`candidate_operator` with ``normals``: the free nodes
+    ``nodes`` (p,), their unit normals (p, 3), ``R`` (n_free × n_free, ``u = R u'``), the
+    projection ``T`` (n_dofs × n_dofs) and the nodes' tangential DOFs (sorted, full numbering)."""
+
+    nodes: np.ndarray
+    normals: np.ndarray
+    R: sp.csr_matrix
+    projection: sp.csr_matrix
+    tangential: np.ndarray
+
+
+def _normal_basis(body: ElasticBody, nodes: np.ndarray, normals: np.ndarray) -> _NormalBasis:
+    """:class:`_NormalBasis` of the scalar DOFs ``nodes`` with unit ``normals``; nodes clamped
+    in all three directions are left out (they do not move); a node clamped in one or two
+    directions is refused."""
+    s = np.asarray(nodes, dtype=np.int64)
+    nv = np.asarray(normals, dtype=float)
+    if s.ndim != 1 or nv.shape != (s.size, 3) or np.unique(s).size != s.size:
+        raise InputError("normals", f"{s.shape} / {nv.shape}", "unique (p,) nodes, (p, 3)")
+    nv = nv / np.linalg.norm(nv, axis=1, keepdims=True)
+    full = 3 * s[:, None] + np.arange(3)  # (p, 3)
+    free = np.isin(full, body.free)
+    if np.any(free.any(axis=1) & ~free.all(axis=1)):
+        raise InputError("normals", "nodes clamped in some directions", "free or clamped nodes")
+    keep = free.all(axis=1)
+    s, nv, full = s[keep], nv[keep], full[keep]
+    # an orthonormal frame (n, t1, t2) per node: t1 from the axis least aligned with n
+    axis = np.eye(3)[np.argmin(np.abs(nv), axis=1)]
+    t1 = np.cross(nv, axis)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(nv, t1)
+    frame = np.stack([nv, t1, t2], axis=1)  # (p, 3 basis vectors, 3 components)
+    pos = np.searchsorted(body.free, full)  # (p, 3) free numbering
+    n_free = body.free.size
+    other = np.setdiff1d(np.arange(n_free), pos.ravel())
+    # R[pos[k], pos[j]] = frame[j, k]: column j of a node's block is its j-th basis vector
+    rows = np.concatenate([np.repeat(pos, 3, axis=1).ravel(), other])
+    cols = np.concatenate([np.tile(pos, (1, 3)).ravel(), other])
+    vals = np.concatenate([frame.transpose(0, 2, 1).reshape(-1), np.ones(other.size)])
+    R = sp.csr_matrix((vals, (rows, cols)), shape=(n_free, n_free))
+    n_dofs = body.n_dofs
+    rest = np.setdiff1d(np.arange(n_dofs), full.ravel())
+    T = sp.csr_matrix(
+        (
+            np.concatenate([nv.ravel(), np.ones(rest.size)]),
+            (
+                np.concatenate([np.repeat(full[:, 0], 3), rest]),
+                np.concatenate([full.ravel(), rest]),
+            ),
+        ),
+        shape=(n_dofs, n_dofs),
+    )
+    return _NormalBasis(s, nv, R, T, np.sort(full[:, 1:].ravel()))
+
+
+def _turned(rot: _NormalBasis | None, dofs: np.ndarray) -> dict[str, object]:
+    """What a block on ``dofs`` depends on of the turned basis: the normals of its nodes
+    (``(Rᵀ K⁻¹ R)`` on those DOFs reads no other node's frame), so that the flank block of a
+    ``hybrid`` operator, whose basis also turns its layer's nodes, is the ``fe`` one's."""
+    if rot is None:
+        return {}
+    keep = np.isin(rot.nodes, np.unique(dofs // 3))
+    return {"normals": {"nodes": rot.nodes[keep], "n": rot.normals[keep]}}
+
+
+class _Stiffness:
+    """The body's free stiffness in the operator's DOF basis (``Rᵀ K R`` with a
+    :class:`_NormalBasis`), made on first call: a run whose blocks are cached never needs it."""
+
+    def __init__(self, body: ElasticBody, rot: _NormalBasis | None) -> None:
+        self.body, self.rot, self._K = body, rot, None
+
+    def __call__(self) -> sp.csr_matrix:
+        if self._K is None:
+            K = self.body.K
+            if self.rot is not None:
+                R = self.rot.R
+                K = (R.T @ K @ R).tocsr()
+                K.sort_indices()
+            self._K = K
+        return self._K
+
+
+def boundary_normals(mesh: skfem.MeshTet, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The P2 nodes of the boundary ``facets`` and their normals.
+
+    Returns ``(s, n)``: the scalar DOFs ``s`` (p,) of the facets' vertices and edge midpoints
+    (scikit-fem's P2 numbering: vertex ``v`` is DOF ``v``, edge ``e`` is ``n_vertices + e``) and
+    unit normals ``n`` (p, 3): at each node the mean of the outward normals of the facets
+    holding it, weighted by their areas (the normal of a smooth surface sampled by flat
+    facets, to the order of the facets' size times its curvature)."""
+    fac = np.asarray(facets, dtype=np.int64)
+    tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3, 3)
+    area_normal = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    far = mesh.p[:, mesh.t[:, mesh.f2t[0, fac]]].mean(axis=1).T  # owning tet's centroid
+    flip = np.sum((far - tri.mean(axis=1)) * area_normal, axis=1) > 0
+    area_normal[flip] *= -1.0
+    node = np.concatenate([mesh.facets[:, fac], mesh.p.shape[1] + mesh.f2e[:, fac]])  # (6, nf)
+    s, inv = np.unique(node.ravel(), return_inverse=True)
+    acc = np.zeros((s.size, 3))
+    np.add.at(acc, inv, np.tile(area_normal, (6, 1)))
+    return s, acc / np.linalg.norm(acc, axis=1, keepdims=True)
+
+
+#: Above this many candidate DOFs the blocks of a grouped operator are computed group by group
+#: (:func:`candidate_operator`): the dense work of one Schur complement onto all of them grows as
+#: the cube of their number.
+UNION_MAX_DOFS = 12_000
 
 
 def _cached_block(
@@ -663,8 +846,8 @@ def cross_compliance(
 ) -> np.ndarray:
     """``Q_c^T G P_f`` (n_probe × n_cells, mm/N): readings ``Q`` (on any candidate DOFs) per unit
     cell force ``P`` (on the load DOFs); ``symmetric``: the symmetric part (``Q = P``)."""
-    rq, Qs = _compact(op, Q, op.dofs, "read")
-    rp, Ps = _compact(op, P, op.cols, "loaded")
+    rq, Qs = _compact(op, op.project(Q), op.dofs, "read")
+    rp, Ps = _compact(op, op.project(P), op.cols, "loaded")
     # Sparse times dense (a column of P or Q has 30-120 entries): measured 2.7x faster than
     # densifying them for a BLAS product at the sizes of a contact zone (500 x 700 rows). Read
     # first (Qᵀ G, on G's rows as gathered): only the (n_probe, n_rp) product is transposed for

@@ -395,7 +395,7 @@ def _covered(tca, pos, models, cells) -> np.ndarray:
     loads = cell_load_operators(models, M1, M2, [cells])
     for model, P in zip((models.pinion, models.gear), loads, strict=True):
         outside = np.ones(P.shape[0])
-        outside[np.union1d(model.op.cols, model.op.fixed)] = 0.0
+        outside[model.op.load_support] = 0.0
         ok &= (abs(sp.csr_matrix(P)).T @ outside) == 0.0
     return ok
 

@@ -19,10 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 
 from fegear.compliance import (
     CandidateOperator,
     body_compliance,
+    boundary_normals,
     candidate_operator,
     find_tets,
     load_operator,
@@ -155,8 +157,16 @@ def build_member_model(
         if np.unique(reads).size != reads.size:  # layers of two teeth meet: one block
             log.info("%s: the layers below the loaded teeth meet; one layer block", name)
             groups = [(flank_dofs, np.setdiff1d(dofs, flank_dofs))]
+    # the operator on the normal DOFs of the flank and layer nodes (docs/ltca/normal_operator.md)
+    normals = _normals(body, facets, layer_tets if layer_mm > 0.0 else None)
     op = candidate_operator(
-        body, dofs, backend=backend, cache_key=key, load_dofs=flank_dofs, groups=groups
+        body,
+        dofs,
+        backend=backend,
+        cache_key=key,
+        load_dofs=flank_dofs,
+        groups=groups,
+        normals=normals,
     )
     log.info(
         "%s: %d DOFs, %d candidate DOFs, operator in %.1f s (%s)",
@@ -176,6 +186,25 @@ def build_member_model(
         layer_tets=layer_tets,
         teeth=teeth,
     )
+
+
+def _normals(
+    body: ElasticBody, facets: np.ndarray, layer_tets: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(s, n)`` for :func:`fegear.compliance.candidate_operator`: the P2 nodes of the working
+    flank ``facets`` with their normals (:func:`fegear.compliance.boundary_normals`) and, with
+    a layer (``layer_tets``, bool per tetrahedron), the other nodes of its tetrahedra, each with
+    the normal of the nearest flank node (the direction the ``hybrid`` fidelity reads at depth
+    below that flank point), sorted by node."""
+    s, n = boundary_normals(body.mesh, facets)
+    if layer_tets is None or not layer_tets.any():
+        return s, n
+    xs = body.scalar_basis.doflocs
+    lay = np.setdiff1d(body.scalar_basis.element_dofs[:, layer_tets].ravel(), s)
+    _, near = cKDTree(xs[:, s].T).query(xs[:, lay].T)
+    nodes = np.concatenate([s, lay])
+    order = np.argsort(nodes)
+    return nodes[order], np.concatenate([n, n[near]])[order]
 
 
 def _facet_dofs(basis, facets: np.ndarray) -> np.ndarray:
