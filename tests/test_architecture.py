@@ -161,7 +161,7 @@ def test_graph_reader_sees_the_known_edges():
     g = _graph()
     assert "ltca" in g["pipeline"]  # the pipeline runs the loaded cycle
     assert "io" in g["pipeline"]  # ... of a case read by io
-    assert "contact" in g["ltca"]  # the LTCA solves with the contact solver
+    assert "mechanics" in g["ltca"]  # the LTCA solves with the contact solver
     assert "pipeline" in g["output"]  # the writers read a GearRun
 
 
@@ -231,7 +231,7 @@ def test_io_does_not_import_upwards(layer):
 def test_contact_solver_knows_nothing_about_gears():
     """The contact solver and the linear algebra under it import no gear code."""
     g = _graph()
-    for low in ("contact", "linalg", "store", "errors"):
+    for low in ("mechanics", "linalg", "store", "errors"):
         assert set(g.get(low, {})) <= {"errors"}, f"fegear.{low} imports {g.get(low)}"
 
 

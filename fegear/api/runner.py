@@ -8,11 +8,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from fegear.api.gear_result import GearResult, gear_result
-from fegear.api.hertz_result import HertzResult, run_hertz
-from fegear.case import HertzCase
-from fegear.case import load_case as _load_case
+from fegear.api.hertz_scene_result import HertzResult, run_hertz
+from fegear.case_files import load_case as _load_case
 from fegear.errors import InputError
 from fegear.io.gear_case import ANALYSIS, FIDELITIES, N_LEVELS, GearCase
+from fegear.scenes.hertz_case import HertzCase
 
 __all__ = ["Progress", "load_case", "run"]
 

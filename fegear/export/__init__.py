@@ -1,7 +1,8 @@
 """Full-FE decks of fegear's problems for CalculiX (and Abaqus), and their results read back.
 
 - :func:`export_ccx`: a case (the Hertz scene, or a gear pair at chosen positions) as
-  ready-to-run ``.inp`` decks (:mod:`fegear.export.hertz_deck`, :mod:`fegear.export.gear_deck`);
+  ready-to-run ``.inp`` decks (:mod:`fegear.export.hertz_scene_deck`,
+  :mod:`fegear.export.gear_deck`);
 - :func:`~fegear.export.ccx_run.run_ccx`: runs ``ccx`` on one, with its wall time and memory;
 - :func:`~fegear.export.ccx_results.read_results`: load shares, p_max, patch semi-axes, TE.
 
@@ -63,7 +64,7 @@ def export_ccx(
     Parameters
     ----------
     case
-        A :class:`~fegear.case.HertzCase` (one deck) or a
+        A :class:`~fegear.scenes.hertz_case.HertzCase` (one deck) or a
         :class:`~fegear.io.gear_case.GearCase` (one deck per pinion angle of ``phi1``).
     element_mm
         Contact element size (mm). Default: the Hertz scene's level (twice its cell size, as
@@ -76,10 +77,10 @@ def export_ccx(
     level
         Gear pairs: sector mesh level away from the contact (default: the case's).
     """
-    from fegear.case import HertzCase
+    from fegear.scenes.hertz_case import HertzCase
 
     if isinstance(case, HertzCase):
-        from fegear.export.hertz_deck import hertz_deck
+        from fegear.export.hertz_scene_deck import hertz_deck
         from fegear.scenes.hertz_scene import (
             CELLS_ACROSS_MINOR,
             ELEMENT_TO_CELL,

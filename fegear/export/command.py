@@ -53,8 +53,8 @@ def _floats(text: str, option: str) -> list[float]:
 def run(args: argparse.Namespace) -> int:
     """Run the subcommand; the exit code."""
     from fegear.api import load_case
-    from fegear.case import HertzCase
     from fegear.export import export_ccx, position_angle, read_results, run_ccx
+    from fegear.scenes.hertz_case import HertzCase
 
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     case = load_case(args.case)

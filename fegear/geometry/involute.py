@@ -73,7 +73,7 @@ class InvoluteDesign:
     tip_relief_start_mm: float | None = None
 
     def __post_init__(self) -> None:
-        from .validation import validate_involute
+        from .design_checks import validate_involute
 
         validate_involute(self)
 

@@ -229,7 +229,7 @@ def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
     The Newton solves of all cells of all positions run as one batch per member and stage
     (gear cell centres, then the corners of both members from their centres).
     """
-    from fegear.assembly import tooth_transform
+    from fegear.geometry.pair_placement import tooth_transform
     from fegear.geometry.transforms import apply_points, apply_vectors, compose, inverse
 
     cyc = run.cycle

@@ -87,7 +87,7 @@ def check_clearance(case: GearCase, pair: GearPair):
     if the error-free pair already interferes)."""
     from dataclasses import replace
 
-    from fegear.assembly import InstallationErrors
+    from fegear.geometry.pair_placement import InstallationErrors
     from fegear.tca.engagement import tip_root_clearance
 
     c = tip_root_clearance(pair.pinion, pair.gear, pair.assembly)

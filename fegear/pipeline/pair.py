@@ -16,14 +16,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from fegear.assembly import (
+from fegear.errors import InputError
+from fegear.geometry.pair_placement import (
     Assembly,
     InstallationErrors,
     face_gear_assembly,
     involute_assembly,
     spiral_bevel_assembly,
 )
-from fegear.errors import InputError
 from fegear.io.gear_case import PAIR_SECTIONS, GearCase
 
 __all__ = ["FAMILIES", "Family", "GearPair", "assemble", "build_pair", "family"]
@@ -38,7 +38,7 @@ class GearPair:
     pinion, gear
         The members (:class:`~fegear.geometry.surface.GeneratedMember`).
     assembly
-        Their :class:`~fegear.assembly.Assembly` with the case's installation errors.
+        Their :class:`~fegear.geometry.pair_placement.Assembly` with the case's installation errors.
     spiral_bevel
         The synthesized :class:`~fegear.geometry.spiral_bevel.SpiralBevelPair` (spiral bevel
         cases only, else None): what re-assembling with other errors needs.
@@ -115,7 +115,7 @@ class FaceGearFamily:
 
 def _face_gear_pinion(fg):
     """The standard (unshifted) pinion of a face-gear drive; its undercut or pointed tip
-    (:func:`fegear.geometry.validation.validate_involute`) refused naming ``pair.n_pinion`` with
+    (:func:`fegear.geometry.design_checks.validate_involute`) refused naming ``pair.n_pinion`` with
     the smallest tooth count that clears it (the pinion has no profile shift of its own)."""
     from fegear.errors import DesignError
 
@@ -151,7 +151,7 @@ class SpurFamily:
 
     def build(self, case: GearCase) -> GearPair:
         from fegear.geometry import InvoluteDesign, InvoluteMember
-        from fegear.geometry.validation import validate_involute_pair
+        from fegear.geometry.design_checks import validate_involute_pair
 
         p = case.pair
         value = self._member_value

@@ -14,7 +14,7 @@ Fidelities available for gear pairs (``docs/fidelity.md``):
 - ``"tca"``: the rigid, unloaded TCA (:func:`fegear.tca.run_tca`): unloaded TE, contact path,
   unloaded bearing pattern. No FE, no loaded results.
 - ``"hybrid"`` (the default of every gear case) and ``"hertz"``: as ``"fe"`` with the compliance
-  of :mod:`fegear.ltca.hybrid` or the per-pair Hertz laws of :mod:`fegear.ltca.hertz_model`.
+  of :mod:`fegear.ltca.hybrid` or the per-pair Hertz laws of :mod:`fegear.ltca.hertz_fidelity`.
 
 Before any FE work, :func:`fegear.pipeline.engagement.check_engagement` decides every way the
 contact can fail. What the run reports (the headlines over the usable positions, the warnings)
@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from fegear.assembly import Assembly
 from fegear.errors import InputError
+from fegear.geometry.pair_placement import Assembly
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.results import LoadedCycle

@@ -10,7 +10,7 @@ writes the sweep outputs (:mod:`fegear.sweep.output`: ``sweep.json``, ``comparis
 Grid specification (``KEY=START:STOP:N`` or ``KEY=V1,V2,...``): ``KEY`` is a case-file key
 ``section.key`` (``errors.dgamma_deg``, ``load.torque2_Nm``, ``pair.module_mm``, ...). Every grid
 point is written into a copy of the base case's TOML document and validated by the case-file
-parser (:func:`fegear.case.parse_case`), so a bad key or value is refused exactly as in a case
+parser (:func:`fegear.case_files.parse_case`), so a bad key or value is refused exactly as in a case
 file, before any work. A load key replaces the case's torque key (a case has exactly one).
 Several grid axes make their Cartesian product.
 
@@ -280,7 +280,7 @@ def parse_grid(spec: str) -> GridAxis:
 
 def _read_toml(path: Path) -> dict[str, Any]:
     """The raw TOML document of a case file (the errors are those of :func:`load_case`)."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
 
     load_case(path)  # every problem of the file itself: one InputError, as for `fegear run`
     return tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
@@ -356,7 +356,7 @@ def build_items(
         A bad case file, grid specification, key or value (named as in the case file, with the
         grid specification it came from), duplicate item names, or bad overrides.
     """
-    from fegear.case import parse_case
+    from fegear.case_files import parse_case
 
     _check_overrides(fidelity, level)
     if not cases:

@@ -16,8 +16,8 @@ terms of bevel practice:
   by ``θ h`` with ``h = (σ e2 × M) · n`` (gear rotation axis ``−σ e2`` in its driving sense), so
   ``ΔTE = −θ = −(δr · n)/h`` at ``φ1 = 0`` to first order, whatever the contact point shift
   (the gap is stationary at the contact point). With the conventions of
-  :mod:`fegear.assembly`: ``δr = ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the gear moves),
-  ``(−Δγ e_y) × M`` (Δγ, pinion axis turned about ``e_y`` through the apex by ``−Δγ``).
+  :mod:`fegear.geometry.pair_placement`: ``δr = ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the
+  gear moves), ``(−Δγ e_y) × M`` (Δγ, pinion axis turned about ``e_y`` through the apex by ``−Δγ``).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..assembly import InstallationErrors, spiral_bevel_assembly
+from ..geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
 from .core import TCAOptions
 from .cycle import run_tca
 from .results import ARCSEC, CycleResult

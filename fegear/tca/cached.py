@@ -9,7 +9,8 @@ torque, another fidelity or mesh level, a re-run) reads it back instead of solvi
 The key (:func:`fegear.store.cache.artefact_key`) holds the members' ``repr`` (their complete
 design data, as for the sector meshes), the assembly's fields, the options and the angles, with
 the code version of the TCA's producer (the source of ``fegear.tca``, ``fegear.geometry``,
-``fegear.assembly`` and ``fegear.hertz``) and the numpy and scipy versions
+``fegear.geometry.pair_placement`` and ``fegear.mechanics.hertz_closed_form``) and the numpy and
+scipy versions
 (:data:`fegear.store.cache.PRODUCERS`), so a change of the code that produces the positions
 invalidates the entry by itself.
 
@@ -29,7 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..assembly import Assembly
+from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
 from .results import PositionResult, from_record, to_record

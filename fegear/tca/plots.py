@@ -199,7 +199,7 @@ def plot_pattern(
 
 
 def plot_assembly_conventions(path: str | Path) -> Path:
-    """The sign conventions of :mod:`fegear.assembly` in two schematic panels."""
+    """The sign conventions of :mod:`fegear.geometry.pair_placement` in two schematic panels."""
     plt = _plt()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.5))
     # intersecting axes (face-gear frame: gear axis z, pinion axis x at height r_p1)

@@ -269,9 +269,9 @@ def helical_hertz_run(name: str = "helical_15", level: int = 0) -> HertzRun:
     """The loaded pair at the pitch point (one position, ``hybrid``; module docstring)."""
     from dataclasses import replace as _replace
 
-    from fegear.hertz import effective_modulus, hertz_line
     from fegear.ltca import LTCAOptions, run_ltca
     from fegear.ltca.line_load import load_distribution
+    from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_line
     from fegear.tca.contact_lines import plane_of_action
 
     t0 = time.perf_counter()

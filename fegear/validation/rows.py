@@ -93,7 +93,7 @@ def hertz_scene_rows(
 ) -> list[Row]:
     """Hertz scene (``cases/hertz_scene.toml``): p0, a, b at each fidelity and level against the
     closed-form Hertz point contact (:func:`fegear.scenes.hertz_scene.hertz_reference`, from
-    :mod:`fegear.hertz`). Three rows: p0 (MPa), a (mm), b (mm)."""
+    :mod:`fegear.mechanics.hertz_closed_form`). Three rows: p0 (MPa), a (mm), b (mm)."""
     from fegear.api import run
 
     case = _case("hertz_scene.toml")
@@ -112,7 +112,8 @@ def hertz_scene_rows(
         raise InputError("levels", (fe_levels, hybrid_levels), "at least one level")
     s = case.scene
     src = (
-        f"Hertz point contact, closed form (Johnson 1985 §4.2; `fegear/hertz.py`): roller "
+        "Hertz point contact, closed form (Johnson 1985 §4.2; "
+        f"`fegear/mechanics/hertz_closed_form.py`): roller "
         f"R {s.roller_radii_mm[0]:g}/{s.roller_radii_mm[1]:g} mm on a flat, {s.force_N:g} N, "
         f"E {s.E_roller_MPa:g} MPa, ν {s.nu_roller:g}"
     )

@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fegear.case import HertzCase
 from fegear.errors import InputError
 from fegear.io.gear_case import ANALYSIS
+from fegear.scenes.hertz_case import HertzCase
 
 __all__ = ["HertzResult", "run_hertz"]
 
@@ -62,7 +62,7 @@ class HertzResult:
         ``block.vtu``, ``roller.vtu``, ``contact_cells.vtu``, ``pressure_map.png``,
         ``convergence.png`` with a study): one run per folder, as :meth:`GearResult.write`.
         Returns the paths."""
-        from fegear.output.hertz_output import write_hertz_outputs
+        from fegear.output.hertz_scene_output import write_hertz_outputs
         from fegear.store.outputs import inspect_output_folder, output_run
 
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
@@ -86,8 +86,9 @@ def run_hertz(
     study: Sequence[int] | None,
     progress=None,
 ) -> HertzResult:
-    """Run the Hertz scene (:func:`fegear.api.run` with a :class:`~fegear.case.HertzCase`)."""
-    from fegear.convergence import observed_rate
+    """Run the Hertz scene (:func:`fegear.api.run` with a
+    :class:`~fegear.scenes.hertz_case.HertzCase`)."""
+    from fegear.mechanics.convergence import observed_rate
     from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
 
     n = len(CELLS_ACROSS_MINOR)
