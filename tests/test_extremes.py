@@ -45,12 +45,15 @@ def _case(tmp_path: Path, text: str, old: str, new: str, name: str = "case.toml"
 @pytest.fixture
 def no_work(monkeypatch):
     """Fail if the run reaches the TCA (what "before any work" means here)."""
+    import fegear.pipeline.run as gear_run
     import fegear.tca.cached as cached
 
     def refuse(*a, **k):
         raise AssertionError("the TCA ran: the limit was not checked when the case was read")
 
+    # the TCA where it is defined and where the run calls it
     monkeypatch.setattr(cached, "cached_tca", refuse)
+    monkeypatch.setattr(gear_run, "cached_tca", refuse)
 
 
 # --------------------------------------------------------------------------------------------

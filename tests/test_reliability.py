@@ -53,6 +53,7 @@ def test_main_job_runs_the_seed_face_gear_at_hybrid(tmp_path, monkeypatch):
     """``fegear run`` with no case: the seed face gear at hybrid level 0 (the run itself, ~1 min
     cold, is ``test_gear_cli.test_no_argument_main_job_writes_all_outputs``, slow): here the
     case and fidelity that reach the analysis, and the summary that records them."""
+    import fegear.api.runner as runner
     import fegear.pipeline.run as gear_run
     from fegear.output.gear_output import gear_summary
 
@@ -62,7 +63,7 @@ def test_main_job_runs_the_seed_face_gear_at_hybrid(tmp_path, monkeypatch):
         seen["case"] = gear_run._override(case, fidelity, level)
         raise KeyboardInterrupt  # stop before the analysis
 
-    monkeypatch.setattr(gear_run, "run_gear_case", fake_run)
+    monkeypatch.setattr(runner, "run_gear_case", fake_run)  # what fegear.run (the CLI) calls
     monkeypatch.chdir(tmp_path)
     assert main(["run", "-q"]) == 130
     case = seen["case"]

@@ -10,7 +10,11 @@ from typing import Any
 
 from fegear.errors import InputError
 from fegear.io.gear_case import ANALYSIS
+from fegear.mechanics.convergence import observed_rate
+from fegear.output.hertz_scene_output import write_hertz_outputs
 from fegear.scenes.hertz_case import HertzCase
+from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
+from fegear.store.outputs import inspect_output_folder, output_run
 
 __all__ = ["HertzResult", "run_hertz"]
 
@@ -62,9 +66,6 @@ class HertzResult:
         ``block.vtu``, ``roller.vtu``, ``contact_cells.vtu``, ``pressure_map.png``,
         ``convergence.png`` with a study): one run per folder, as :meth:`GearResult.write`.
         Returns the paths."""
-        from fegear.output.hertz_scene_output import write_hertz_outputs
-        from fegear.store.outputs import inspect_output_folder, output_run
-
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
             return tuple(
                 write_hertz_outputs(
@@ -88,9 +89,6 @@ def run_hertz(
 ) -> HertzResult:
     """Run the Hertz scene (:func:`fegear.api.run` with a
     :class:`~fegear.scenes.hertz_case.HertzCase`)."""
-    from fegear.mechanics.convergence import observed_rate
-    from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
-
     n = len(CELLS_ACROSS_MINOR)
     if backend is not None:
         ANALYSIS.key("backend").check("backend", backend)  # the case file's rule

@@ -41,6 +41,7 @@ DEFAULT_GEAR_ELEMENT_MM = 0.5
 def position_angle(case, index: int) -> float:
     """Pinion angle (rad) of position ``index`` of the case's cycle of ``n_positions``
     (``−π/N1 + 2π index / (N1 n)``: the positions of ``fegear run``)."""
+    # local: the pipeline pulls scipy; the `fegear` command's parser imports this package
     from fegear.pipeline.pair import build_pair
 
     n = case.n_positions
@@ -77,9 +78,12 @@ def export_ccx(
     level
         Gear pairs: sector mesh level away from the contact (default: the case's).
     """
+    # local: the scene and the decks pull scipy, scikit-fem and meshio; the `fegear` command's
+    # parser imports this package
     from fegear.scenes.hertz_case import HertzCase
 
     if isinstance(case, HertzCase):
+        # local: as above
         from fegear.export.hertz_scene_deck import hertz_deck
         from fegear.scenes.hertz_scene import (
             CELLS_ACROSS_MINOR,
@@ -94,7 +98,7 @@ def export_ccx(
             element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[case.level]
         return [hertz_deck(case.scene, element_mm, name=f"{case.name}_{element_mm:.3g}mm")
                 .write(out)]  # fmt: skip
-    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck
+    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck  # local: as above
 
     if not phi1:
         raise InputError("positions", [], "at least one position of a gear pair")

@@ -58,6 +58,7 @@ from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.surface import finite_difference_curvatures
 from fegear.geometry.transforms import apply_vectors, compose
 from fegear.ltca.grid import pair_cells, separation_at, take_cells, tca_edge_names
+from fegear.ltca.model import cell_load_operators
 from fegear.ltca.results import LoadedPosition, PairContact
 from fegear.ltca.zone import left_out_pairs
 from fegear.mechanics.contact import ContactSolution
@@ -390,8 +391,6 @@ def _metric(uv: np.ndarray, P: np.ndarray, fm, at) -> tuple[float, float]:
 def _covered(tca, pos, models, cells) -> np.ndarray:
     """``(n,)`` bool: the cells whose consistent loads lie on DOFs both members' compliance
     operators cover (their load DOFs, or constrained DOFs)."""
-    from fegear.ltca.model import cell_load_operators
-
     M1, M2 = tca.asm.placement1(pos.phi1), tca.asm.placement2(pos.phi2)
     ok = np.ones(cells.n, dtype=bool)
     loads = cell_load_operators(models, M1, M2, [cells])

@@ -61,7 +61,7 @@ import numpy as np
 
 from fegear.errors import InputError
 from fegear.store.checksum import file_checksum
-from fegear.store.files import atomic_write
+from fegear.store.files import atomic_write, check_writable_folder
 from fegear.store.limit import ENV_LIMIT, cache_limit, evict, stored_entries
 
 __all__ = [
@@ -808,8 +808,6 @@ def check_cache_root() -> Path:
     InputError
         The root is unusable (the CLI's exit code 2).
     """
-    from fegear.store.files import check_writable_folder
-
     root = cache_root()
     field = "FEGEAR_CACHE" if os.environ.get("FEGEAR_CACHE", "").strip() else "cache folder"
     check_writable_folder(root, field)

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
+from ..geometry.transforms import apply_points, inverse
 from .core import TCAOptions
 from .cycle import run_tca
 from .results import ARCSEC, CycleResult
@@ -197,8 +198,6 @@ def path_angle_on_gear(pair, side: str = "drive", dphi: float = 0.02) -> tuple[f
     (η is measured from the tooth trace toward the tip, :class:`SynthesisTargets`; the path is a
     line, so the difference is taken modulo 180°).
     """
-    from ..geometry.transforms import apply_points, inverse
-
     asm = spiral_bevel_assembly(pair, side)
     opt = TCAOptions(separation_grid=None, pair_offsets=(0,))
     r = run_tca(pair.pinion, pair.gear, asm, opt, phi1=np.array([-dphi, dphi]))

@@ -30,6 +30,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from fegear.store.cache import cached_record
+
 from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
@@ -106,8 +108,6 @@ def cached_phase(pinion, gear, assembly: Assembly, options: TCAOptions) -> float
     face gear the phasing is about 60 % of a new error's TCA)."""
     from dataclasses import replace
 
-    from fegear.store.cache import cached_record
-
     nominal = assembly.without_errors()
     opt = replace(options, separation_grid=None, pinion_torque_Nm=None)
     params = pair_key(pinion, gear, nominal, opt)
@@ -128,8 +128,6 @@ def cached_tca(
     Returns the :class:`~fegear.tca.TCA` of the phased assembly (the loaded analysis evaluates
     its flank maps) and the positions.
     """
-    from fegear.store.cache import cached_record
-
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, object] = {}

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .ellipse import outline
 from .results import CycleResult
 
 __all__ = [
@@ -145,8 +146,6 @@ def draw_ellipses(
     (x (n,), y (n,))`` the plot coordinates of flank coordinates (default ``(v, u)``). Returns the
     number of outlines drawn (line contacts have none).
     """
-    from .ellipse import outline
-
     xy = xy or (lambda uv: (uv[:, 1], uv[:, 0]))
     styles = {"paint": "-", "hertz": "--"}
     n = 0
