@@ -2,8 +2,8 @@
 
 Two half-space contacts of a cylinder (radius 20 mm, line load 500 N/mm, steel: Hertz semi-width
 ``b`` = 0.335 mm, ``p0`` = 949 MPa), solved with fegear's own contact solver on cells carrying
-uniform pressure (:func:`fegear.halfspace.halfspace_influence`,
-:func:`fegear.contact.solve_contact`):
+uniform pressure (:func:`fegear.mechanics.halfspace.halfspace_influence`,
+:func:`fegear.mechanics.contact.solve_contact`):
 
 A. **An edge across the contact line** (a face end): a straight roller of length 16 b ending
    abruptly at ``y = 0`` and ``y = 16 b``. The peak pressure across the roller at a distance
@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fegear.contact import solve_contact
-from fegear.halfspace import halfspace_influence
-from fegear.hertz import effective_modulus, hertz_line
+from fegear.mechanics.contact import solve_contact
+from fegear.mechanics.halfspace import halfspace_influence
+from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_line
 
 E_STAR = effective_modulus(206000.0, 0.3, 206000.0, 0.3)
 R_MM, W_N_PER_MM = 20.0, 500.0

@@ -45,7 +45,7 @@ SCENES = {
 CHILD = r"""
 import json, resource, sys, time
 import numpy as np
-from fegear.case import load_case
+from fegear.case_files import load_case
 from fegear.pipeline.pair import build_pair
 from fegear.ltca import LTCAOptions, run_ltca
 path, fid, lv, npos = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
@@ -183,8 +183,8 @@ def table(scene: str, runs: list[dict]) -> str:
         "holds the cold run's own load); others = the CPU seconds the other processes of the "
         "machine used during the cold / warm run; "
         "p_max int. = over the positions where neither run has an "
-        "edge contact; p_peak = the recovered peak of :func:`fegear.patch.measure_patch`, "
-        "p_max = the largest cell pressure)",
+        "edge contact; p_peak = the recovered peak of "
+        ":func:`fegear.mechanics.patch.measure_patch`, p_max = the largest cell pressure)",
         "",
         "| fidelity | level | cold s | warm s | warm positions s | load avg | peak RSS MB "
         "| TE p-p ″ | mean TE ″ | contact ratio "

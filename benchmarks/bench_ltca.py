@@ -27,7 +27,7 @@ HERE = Path(__file__).parent
 CHILD = r"""
 import json, resource, sys, time
 import numpy as np
-from fegear.assembly import InstallationErrors, face_gear_assembly
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly
 from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember
 from fegear.ltca import LTCAOptions, build_models, run_ltca
 fid, lv = sys.argv[1], int(sys.argv[2])

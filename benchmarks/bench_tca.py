@@ -14,8 +14,12 @@ from __future__ import annotations
 import logging
 import time
 
-from fegear.assembly import InstallationErrors, face_gear_assembly, spiral_bevel_assembly
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import (
+    InstallationErrors,
+    face_gear_assembly,
+    spiral_bevel_assembly,
+)
 from fegear.geometry.spiral_bevel import SpiralBevelPair
 from fegear.tca import TCAOptions, run_tca
 

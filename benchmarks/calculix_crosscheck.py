@@ -211,7 +211,8 @@ def markdown(doc: dict) -> str:
         L += ["## Hertz scene (quarter model, 2000 N)", "",
               f"Hertz: p0 {ref['p0_MPa']:.1f} MPa, a {ref['a_mm']:.4f} mm, b "
               f"{ref['b_mm']:.4f} mm. CalculiX: p0 is the largest nodal `CPRESS` (and the "
-              "peak recovered from the nodal forces, `fegear.patch.measure_patch`), a and b the "
+              "peak recovered from the nodal forces, `fegear.mechanics.patch.measure_patch`), "
+              "a and b the "
               "semi-axes of the nodal forces' second moments; fegear `hybrid` (FE of level 0): "
               "the recovered peak and the same second moments on its cells.", "",
               "| solver | contact elements (mm) | elements across 2b | DOFs | p0 err | p0 err "

@@ -2,7 +2,8 @@
 
 What to look for: Δq changes the depth of mesh, and the localized contact answers by sliding
 along the face: Δq > 0 (the face gear moved along its axis away from the pinion axis, a
-shallower mesh; signs in ``fegear.assembly``) takes the pattern toward the inner end, about
+shallower mesh; signs in ``fegear.geometry.pair_placement``) takes the pattern toward the inner
+end, about
 8 mm per 0.1 mm, and shifts the unloaded TE curve by a constant; the contact ratio follows.
 
     python cases/face_gear_dA2.py [FIDELITY]   # default: the case's (hybrid); tca: seconds

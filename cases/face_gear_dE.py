@@ -2,7 +2,7 @@
 
 What to look for: ΔE slides the bearing pattern along the face (ΔE > 0 toward the inner end)
 and shifts the whole unloaded TE curve by a constant, so the unloaded TE stays flat; the
-contact ratio grows with ΔE. Sign conventions: ``fegear.assembly`` (docs/tca).
+contact ratio grows with ΔE. Sign conventions: ``fegear.geometry.pair_placement`` (docs/tca).
 
     python cases/face_gear_dE.py [FIDELITY]   # default: the case's (hybrid); tca: seconds
 

@@ -235,7 +235,7 @@ def write(rows: list[Row], section_seconds: dict[str, float]) -> None:
 
 Each row sets a fegear result against a reference computed without the solver: a closed form, a
 standard (ISO 6336), or the design target the geometry was synthesized for. The references are in
-`fegear/validation/iso6336.py` and `fegear/hertz.py`, the measurements in
+`fegear/validation/iso6336.py` and `fegear/mechanics/hertz_closed_form.py`, the measurements in
 `fegear/validation/rows.py`; each row is a test in `tests/test_validation.py` (the slow ones
 under `-m slow`) with its tolerance and the reason for it.
 

@@ -43,7 +43,7 @@ _LAZY = {
     "GearResult": "fegear.api",
     "HertzResult": "fegear.api",
     "GearCase": "fegear.io.gear_case",
-    "HertzCase": "fegear.case",
+    "HertzCase": "fegear.scenes.hertz_case",
     "FegearError": "fegear.errors",
     "InputError": "fegear.errors",
 }
@@ -58,9 +58,9 @@ if TYPE_CHECKING:  # pragma: no cover
         run,
         table,
     )
-    from fegear.case import HertzCase
     from fegear.errors import FegearError, InputError
     from fegear.io.gear_case import GearCase
+    from fegear.scenes.hertz_case import HertzCase
 
 
 def __getattr__(name: str) -> Any:

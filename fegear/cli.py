@@ -45,6 +45,11 @@ from pathlib import Path
 
 from fegear import __version__
 from fegear.errors import FegearError, InputError
+from fegear.export.command import add_parser as add_export
+from fegear.export.command import run as export_ccx
+from fegear.store.cache import cache_info, check_cache_root, clear_cache
+from fegear.store.files import check_writable_folder, journal
+from fegear.store.outputs import MANIFEST, inspect_output_folder, run_files
 
 __all__ = ["main", "parser"]
 
@@ -155,8 +160,6 @@ def _parser() -> argparse.ArgumentParser:
                     help="whose flank (default: gear)")  # fmt: skip
     pl.add_argument("--png", help="the PNG (default: FOLDER/bearing_pattern_<member>_flank.png)")
     pl.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
-    from fegear.export.command import add_parser as add_export
-
     add_export(sub)
     return p
 
@@ -173,13 +176,14 @@ def _as_option(exc: InputError) -> InputError:
 
 
 def _run(args: argparse.Namespace) -> int:
+    # local: the API and the gear case pull scipy and scikit-fem (~2 s); `fegear --help` does not
     from fegear.api import load_case
     from fegear.io.gear_case import GearCase
 
     if args.case:
         case = load_case(args.case)
     else:
-        from fegear.io.seed import seed_case
+        from fegear.io.seed import seed_case  # local: scipy, as above
 
         case = seed_case()
     try:
@@ -191,10 +195,10 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _run_gear(args: argparse.Namespace, case) -> int:
+    # local: the API and the LTCA pull scipy and scikit-fem (~2 s); `fegear --help` does not
     from fegear.api import run
     from fegear.io.gear_case import UNLOADED
     from fegear.ltca.fidelity import FIDELITIES
-    from fegear.store.outputs import inspect_output_folder
 
     if args.study:
         raise InputError("--study", args.study, "absent for a gear case (a Hertz-scene option)")
@@ -326,8 +330,7 @@ def _value(x: float | None, fmt: str, unit: str) -> str:
 
 
 def _run_hertz(args: argparse.Namespace, case) -> int:
-    from fegear.api import run
-    from fegear.store.outputs import inspect_output_folder
+    from fegear.api import run  # local: scipy and scikit-fem (~2 s), as in _run_gear
 
     study = None
     if args.study:
@@ -383,8 +386,6 @@ def _run_hertz(args: argparse.Namespace, case) -> int:
 
 
 def _cache(args: argparse.Namespace) -> int:
-    from fegear.store.cache import cache_info, clear_cache
-
     if args.cache_command == "clear":
         gone = clear_cache(args.kind)
         if not gone.exists:
@@ -435,10 +436,9 @@ def _size(n: int) -> str:
 def _plot(args: argparse.Namespace) -> int:
     import json
 
+    # local: the flank view and its VTP reader pull scipy and scikit-fem (~2 s)
     from fegear.output.flank_view import plot_flank_pattern
     from fegear.output.flank_vtp import read_flank_vtp
-    from fegear.store.files import journal
-    from fegear.store.outputs import MANIFEST, run_files
 
     folder = Path(args.folder)
     listed = run_files(folder)  # the files of the folder's run, never a stale one of another
@@ -483,8 +483,7 @@ def _plot(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from fegear.store.files import check_writable_folder
-    from fegear.sweep import build_items, require_dask, run_sweep
+    from fegear.sweep import build_items, require_dask, run_sweep  # local: scipy, scikit-fem
 
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     t_start = time.perf_counter()
@@ -549,8 +548,6 @@ def main(argv: list[str] | None = None) -> int:
     )
     try:
         if args.command in ("run", "sweep", "export-ccx"):
-            from fegear.store.cache import check_cache_root
-
             check_cache_root()  # an unusable FEGEAR_CACHE is refused before any work
         if args.command == "run":
             return _run(args)
@@ -561,8 +558,6 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "plot":
             return _plot(args)
         if args.command == "export-ccx":
-            from fegear.export.command import run as export_ccx
-
             return export_ccx(args)
     except InputError as exc:
         print(f"fegear: error: {exc}", file=sys.stderr)

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 import fegear
-from fegear.case import parse_case
+from fegear.case_files import parse_case
 from fegear.cli import main
 from fegear.errors import InputError
 

@@ -155,13 +155,43 @@ def _module_graph() -> dict[str, dict[str, list[str]]]:
     return graph
 
 
+def _local_imports(path: Path) -> list[ast.ImportFrom | ast.Import]:
+    """The imports of fegear modules inside the functions of one source file."""
+    out: list[ast.ImportFrom | ast.Import] = []
+
+    def visit(node: ast.AST, in_function: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            if in_function and isinstance(child, ast.Import):
+                if any(a.name.startswith("fegear") for a in child.names):
+                    out.append(child)
+            elif in_function and isinstance(child, ast.ImportFrom):
+                if child.level or (child.module or "").startswith("fegear"):
+                    out.append(child)
+            visit(child, in_function or isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef))
+
+    visit(ast.parse(path.read_text(encoding="utf-8")), False)
+    return out
+
+
+def _has_reason(lines: list[str], node: ast.stmt, import_lines: set[int]) -> bool:
+    """A ``# local:`` comment on the import or in the comments and imports right above it."""
+    if any("# local:" in lines[i - 1] for i in range(node.lineno, node.end_lineno + 1)):
+        return True
+    i = node.lineno - 1
+    while i >= 1 and (i in import_lines or lines[i - 1].strip().startswith("#")):
+        if "# local:" in lines[i - 1]:
+            return True
+        i -= 1
+    return False
+
+
 def test_graph_reader_sees_the_known_edges():
     """The reader is not blind: edges that must exist are found (a broken reader that returns
     nothing would pass the two tests below)."""
     g = _graph()
     assert "ltca" in g["pipeline"]  # the pipeline runs the loaded cycle
     assert "io" in g["pipeline"]  # ... of a case read by io
-    assert "contact" in g["ltca"]  # the LTCA solves with the contact solver
+    assert "mechanics" in g["ltca"]  # the LTCA solves with the contact solver
     assert "pipeline" in g["output"]  # the writers read a GearRun
 
 
@@ -231,7 +261,7 @@ def test_io_does_not_import_upwards(layer):
 def test_contact_solver_knows_nothing_about_gears():
     """The contact solver and the linear algebra under it import no gear code."""
     g = _graph()
-    for low in ("contact", "linalg", "store", "errors"):
+    for low in ("mechanics", "linalg", "store", "errors"):
         assert set(g.get(low, {})) <= {"errors"}, f"fegear.{low} imports {g.get(low)}"
 
 
@@ -260,3 +290,56 @@ def test_the_gear_families_are_the_case_kinds():
     assert set(FAMILIES) == set(GEAR_KINDS)
     for kind, fam in FAMILIES.items():
         assert fam.kind == kind
+
+
+#: The imports of fegear modules that stay inside functions. Every other import is at module
+#: level: a function-local import hides a dependency from the reader (a circle stays a circle,
+#: see above) and is paid on every call. These stay because the command line starts light:
+#: ``fegear/cli.py`` and the CalculiX exporter (``fegear/export/__init__.py``,
+#: ``fegear/export/command.py``: the command builds its parser from them) import the API, the
+#: LTCA, the flank views, the sweeps and the scenes, which pull scipy and scikit-fem (~2 s),
+#: only in the subcommand that uses them, so that ``fegear --help`` and ``fegear cache`` do not.
+#: Each carries a ``# local:`` comment with its reason. Lower this number when one goes.
+MAX_LOCAL_IMPORTS = 17
+
+
+def test_function_local_imports_are_few_and_say_why():
+    found = {p: _local_imports(p) for p in sorted(PACKAGE.rglob("*.py")) if _local_imports(p)}
+    listing = [
+        f"{p.relative_to(PACKAGE.parent)}:{n.lineno}: {ast.unparse(n)}"
+        for p, nodes in found.items()
+        for n in nodes
+    ]
+    assert len(listing) <= MAX_LOCAL_IMPORTS, (
+        f"{len(listing)} function-local imports of fegear modules (at most "
+        f"{MAX_LOCAL_IMPORTS}): import at module level\n" + "\n".join(listing)
+    )
+    silent = []
+    for p, nodes in found.items():
+        lines = p.read_text(encoding="utf-8").splitlines()
+        import_lines = {i for n in nodes for i in range(n.lineno, n.end_lineno + 1)}
+        silent += [
+            f"{p.relative_to(PACKAGE.parent)}:{n.lineno}"
+            for n in nodes
+            if not _has_reason(lines, n, import_lines)
+        ]
+    assert not silent, "function-local imports without a '# local:' reason: " + ", ".join(silent)
+
+
+def test_the_local_import_reader_sees_them():
+    """The reader is not blind: the command line's imports of the API are found."""
+    names = [ast.unparse(n) for n in _local_imports(PACKAGE / "cli.py")]
+    assert "from fegear.api import run" in names
+
+
+def test_the_mechanics_is_a_package_of_its_own_and_knows_no_gear():
+    """The gear-agnostic mechanics: its modules are in the module graph (the LTCA solves with
+    its contact solver), none of them is in a cycle, and they import only :mod:`fegear.errors`."""
+    g = _module_graph()
+    assert "fegear.mechanics.contact" in g["fegear.ltca.position"]
+    mechanics = [m for m in g if m.startswith("fegear.mechanics.")]
+    assert mechanics, "the reader sees no module of fegear.mechanics"
+    for m in mechanics:
+        assert set(g[m]) <= {"fegear.errors"}, f"{m} imports {sorted(g[m])}"
+    in_cycles = {m for comp in _cycles(g) for m in comp}
+    assert not {m for m in in_cycles if m.startswith("fegear.mechanics")}

@@ -1,4 +1,4 @@
-"""Assembly placements and installation-error sign conventions (fegear.assembly)."""
+"""Assembly placements and installation-error sign conventions (fegear.geometry.pair_placement)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, face_gear_assembly, involute_assembly
 from fegear.errors import InputError
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly, involute_assembly
 
 P = InvoluteMember(InvoluteDesign(16, 4.5, 20, profile_shift=0.1817, face_width_mm=14), "pinion")
 G = InvoluteMember(InvoluteDesign(24, 4.5, 20, profile_shift=0.1715, face_width_mm=14), "gear")

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, involute_assembly
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, involute_assembly
 from fegear.store import cache as fcache
 from fegear.tca import TCAOptions
 from fegear.tca import cached as tcached
@@ -86,7 +86,8 @@ def fake_fegear(tmp_path, monkeypatch):
     root = tmp_path / "fegear"
     (root / "mesh").mkdir(parents=True)
     (root / "mesh" / "sector.py").write_text("A = 1\n")
-    (root / "hertz.py").write_text("B = 1\n")
+    (root / "mechanics").mkdir()
+    (root / "mechanics" / "hertz_closed_form.py").write_text("B = 1\n")
     monkeypatch.setattr(fcache, "_FEGEAR", root)
     fcache._code_hash.cache_clear()
     yield root
@@ -94,8 +95,10 @@ def fake_fegear(tmp_path, monkeypatch):
 
 
 def test_code_hash_is_the_source_of_the_producing_packages(fake_fegear):
-    both = fcache.code_hash("fegear.mesh", "fegear.hertz")
-    assert fcache.code_hash("fegear.hertz", "fegear.mesh", "fegear.mesh") == both
+    both = fcache.code_hash("fegear.mesh", "fegear.mechanics.hertz_closed_form")
+    assert (
+        fcache.code_hash("fegear.mechanics.hertz_closed_form", "fegear.mesh", "fegear.mesh") == both
+    )
     mesh = fcache.code_hash("fegear.mesh")
     (fake_fegear / "mesh" / "sector.py").write_text("A = 2\n")
     assert fcache.code_hash("fegear.mesh") == mesh  # read once per process
@@ -121,7 +124,11 @@ def test_every_kind_has_a_producer_found_in_this_installation():
     assert {"fegear.fem", "fegear.compliance", "fegear.linalg"} <= set(
         fcache.PRODUCERS["compliance"].code
     )
-    assert {"fegear.tca", "fegear.geometry", "fegear.assembly"} <= set(fcache.PRODUCERS["tca"].code)
+    # the TCA's code: the pair's placement is fegear/geometry/pair_placement.py, and its
+    # contact ellipses are closed-form Hertz
+    assert {"fegear.tca", "fegear.geometry", "fegear.mechanics.hertz_closed_form"} <= set(
+        fcache.PRODUCERS["tca"].code
+    )
 
 
 def test_a_kind_without_a_producer_is_refused(private_cache):

@@ -19,7 +19,7 @@ from fegear.api import load_case
 from fegear.errors import InputError
 from fegear.export import export_ccx, read_results, run_ccx
 from fegear.export.ccx_results import read_dat
-from fegear.export.hertz_deck import barrel_projection, hertz_deck
+from fegear.export.hertz_scene_deck import barrel_projection, hertz_deck
 from fegear.scenes.hertz_scene import HertzScene, hertz_reference
 
 CASES = Path(__file__).resolve().parent.parent / "cases"

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from cli_checks import assert_refused, one_line
 
-from fegear.case import load_case
+from fegear.case_files import load_case
 from fegear.cli import main
 
 REPO = Path(__file__).resolve().parents[1]

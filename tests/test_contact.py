@@ -1,10 +1,11 @@
-"""Tests of the active-set contact solver (fegear.contact).
+"""Tests of the active-set contact solver (fegear.mechanics.contact).
 
 Two kinds of reference:
 
 - physics: a Hertz contact pressed onto the elastic half-space (Love's influence of uniform
-  pressure on rectangular cells, fegear.halfspace) has the closed-form Hertz answer, including the
-  rigid approach, so the solver with that operator must converge to ``fegear.hertz``;
+  pressure on rectangular cells, fegear.mechanics.halfspace) has the closed-form Hertz answer,
+  including the rigid approach, so the solver with that operator must converge to
+  ``fegear.mechanics.hertz_closed_form``;
 - mathematics: the problem is the KKT system of a strictly convex QP with one equality, so the
   solution is unique and can be found independently by enumerating active sets (n ≤ 8) or by
   ``scipy.optimize.minimize`` (SLSQP).
@@ -27,10 +28,15 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from fegear.contact import ContactSolution, solve_contact
 from fegear.errors import InputError, SolverError
-from fegear.halfspace import halfspace_influence
-from fegear.hertz import HertzPoint, effective_modulus, hertz_line, hertz_point_radii
+from fegear.mechanics.contact import ContactSolution, solve_contact
+from fegear.mechanics.halfspace import halfspace_influence
+from fegear.mechanics.hertz_closed_form import (
+    HertzPoint,
+    effective_modulus,
+    hertz_line,
+    hertz_point_radii,
+)
 
 E_STEEL = 206000.0
 NU_STEEL = 0.3

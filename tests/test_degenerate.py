@@ -63,7 +63,7 @@ def test_the_rule_is_the_unresolved_share_against_one_percent(pairs, expected):
 def seed_face_gear():
     """The seed face gear's ``hybrid`` level 0 models (those of the rated case: the contact zone
     and the sectors do not depend on the load; shared with tests/test_ltca_cycle.py)."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.ltca import LTCAOptions, build_models
     from fegear.pipeline.pair import build_pair
 
@@ -88,7 +88,7 @@ def seed_face_gear():
 def test_the_seed_face_gear_entering_pair_on_both_sides(seed_face_gear, case, position, expected):
     """The issue's two cases: the entering pair at the face-gear tip, unresolved at both loads;
     the position is degenerate exactly where that pair carries at least 1 % of the torque."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.ltca import run_ltca
 
     pair, opt, models = seed_face_gear

@@ -45,12 +45,15 @@ def _case(tmp_path: Path, text: str, old: str, new: str, name: str = "case.toml"
 @pytest.fixture
 def no_work(monkeypatch):
     """Fail if the run reaches the TCA (what "before any work" means here)."""
+    import fegear.pipeline.run as gear_run
     import fegear.tca.cached as cached
 
     def refuse(*a, **k):
         raise AssertionError("the TCA ran: the limit was not checked when the case was read")
 
+    # the TCA where it is defined and where the run calls it
     monkeypatch.setattr(cached, "cached_tca", refuse)
+    monkeypatch.setattr(gear_run, "cached_tca", refuse)
 
 
 # --------------------------------------------------------------------------------------------
@@ -108,7 +111,7 @@ def test_profile_shift_sum_is_refused_with_the_tip_clearance_limit(tmp_path, cap
     """``profile_shift = [0.7, 0.9]``: the tips run 0.1105 mm into the roots at the zero-backlash
     centre distance; the largest shift sum that clears is 1.5098. At that sum (the shifts in the
     same proportion) the measured clearance of the assembled pair is zero to a micrometre."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.pipeline.pair import build_pair
     from fegear.tca.engagement import tip_root_clearance
 
@@ -407,7 +410,7 @@ def test_a_byte_order_mark_is_accepted():
     """A case file saved by a Windows editor (UTF-8 with a BOM) reads as the same case."""
     import tempfile
 
-    from fegear.case import load_case
+    from fegear.case_files import load_case
 
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "bom.toml"
@@ -420,7 +423,7 @@ def test_a_pair_that_jams_is_warned_with_the_depth(tmp_path, capsys):
     """FZG at ``da_mm = -0.5``: the teeth, cut without backlash, overlap by 0.3755 mm along the
     line of action (warning naming ``errors.da_mm``). The closed form against the textbook's
     first-order backlash ``j_n = 2 Δa sin α_w cos β_b``: 1e-4 relative at Δa = -1 µm."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.pipeline.pair import build_pair
     from fegear.tca.engagement import jamming
 

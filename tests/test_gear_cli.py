@@ -20,10 +20,11 @@ import numpy as np
 import pytest
 from cli_checks import assert_refused, one_line
 
-from fegear.case import HertzCase, load_case
+from fegear.case_files import load_case
 from fegear.cli import main
 from fegear.io.gear_case import GearCase, parse_gear_case
 from fegear.io.seed import SEED_CASE_TOML, seed_case
+from fegear.scenes.hertz_case import HertzCase
 
 REPO = Path(__file__).resolve().parents[1]
 CASES = sorted((REPO / "cases").glob("*.toml"))

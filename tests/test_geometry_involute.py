@@ -118,7 +118,7 @@ def test_validation_names_the_field():
     # tip (the tooth thickness at the tip circle, closed form, vanishes there to 1e-9 rad)
     with pytest.raises(DesignError, match=r"profile_shift.*<= 0\.6996.*pointed") as e:
         InvoluteDesign(n_teeth=10, module_mm=1.0, profile_shift=1.2)
-    from fegear.geometry.validation import _pointed_shift, _tip_half_angle
+    from fegear.geometry.design_checks import _pointed_shift, _tip_half_angle
 
     d = InvoluteDesign(n_teeth=10, module_mm=1.0, profile_shift=0.5)
     x_max = _pointed_shift(d)  # bisection to 1e-12 in x; dψ_a/dx ~ 0.1 rad

@@ -1,4 +1,4 @@
-"""Tests of the closed-form half-space influence (fegear.halfspace).
+"""Tests of the closed-form half-space influence (fegear.mechanics.halfspace).
 
 References, all independent of Love's closed form:
 
@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad
 
-from fegear import halfspace
-from fegear.halfspace import (
+from fegear.mechanics import halfspace
+from fegear.mechanics.halfspace import (
     halfspace_influence,
     layout_influence,
     rectangle_integral,

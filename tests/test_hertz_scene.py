@@ -25,8 +25,8 @@ import math
 import numpy as np
 import pytest
 
-from fegear.convergence import observed_rate
 from fegear.errors import InputError
+from fegear.mechanics.convergence import observed_rate
 from fegear.scenes.hertz_scene import (
     CELLS_ACROSS_MINOR,
     MIN_CELLS_ACROSS_MINOR,

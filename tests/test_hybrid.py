@@ -22,7 +22,7 @@ import math
 import numpy as np
 import pytest
 
-from fegear.convergence import observed_rate
+from fegear.mechanics.convergence import observed_rate
 from fegear.scenes.hertz_scene import HertzScene, run_level
 
 NOMINAL = HertzScene()
@@ -188,7 +188,7 @@ def _face_gear_cycle(options, phi1=None):
     """The seed face gear's loaded cycle (the case file's pair and torque) with ``options``."""
     from pathlib import Path
 
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.ltca import run_ltca
     from fegear.pipeline.pair import build_pair
 

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fegear.assembly import involute_assembly
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import involute_assembly
 from fegear.ltca import LTCAOptions, build_models, run_ltca
 from fegear.tca import TCA, TCAOptions, reference_phase
 
@@ -155,7 +155,7 @@ def test_bad_torque_is_refused(setup):
 def test_loss_of_contact_is_a_result_not_a_crash():
     """An 8 mm centre-distance increase leaves positions where no flank pair can carry load
     (contact ratio below one, or contact only at a tooth tip edge): those positions say so."""
-    from fegear.assembly import InstallationErrors
+    from fegear.geometry.pair_placement import InstallationErrors
 
     asm = involute_assembly(PINION, GEAR, InstallationErrors(da_mm=8.0))
     c = run_ltca(PINION, GEAR, asm, RATED, OPTIONS)

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, spiral_bevel_assembly
+from fegear.geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
 from fegear.geometry.spiral_bevel import SpiralBevelPair
 from fegear.ltca import LTCAOptions, build_models, run_ltca
 

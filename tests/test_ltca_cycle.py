@@ -14,9 +14,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from fegear.assembly import involute_assembly
 from fegear.errors import InputError
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import involute_assembly
 from fegear.ltca import LTCAOptions, build_models, run_ltca
 from fegear.ltca.cycle import chunks
 
@@ -126,7 +126,7 @@ def seed_face_gear():
     models (one worker: the positions are solved in this process)."""
     from pathlib import Path
 
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.pipeline.pair import build_pair
 
     case = load_case(Path(__file__).parents[1] / "cases" / "face_gear_nominal.toml")

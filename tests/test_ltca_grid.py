@@ -13,12 +13,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, face_gear_assembly
 from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember
-from fegear.halfspace import layout_influence, tangent_layout
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly
 from fegear.ltca.grid import near_cells, pair_cells
 from fegear.ltca.zone import contact_zone
-from fegear.patch import measure_patch
+from fegear.mechanics.halfspace import layout_influence, tangent_layout
+from fegear.mechanics.patch import measure_patch
 from fegear.tca import TCA, TCAOptions
 
 G_MAX = 0.013  # mm: the hybrid's cell bound at that position (1.5 θ h of the previous grid)
@@ -123,7 +123,8 @@ def test_the_cell_geometry_does_not_depend_on_how_the_grid_is_turned(face_gear):
     the seed face gear (an involute: its metric changes along the profile) the cells of a turned
     grid are sheared parallelograms whose widths vary ±20 % down a grid column. The half-space
     near field lays each cell out in its own tangent plane
-    (:func:`fegear.halfspace.tangent_layout`) and the patch measures use the tangent plane at
+    (:func:`fegear.mechanics.halfspace.tangent_layout`) and the patch measures use the tangent
+    plane at
     the pair's closest point, so neither may depend on the turn. Reference: a grid along the
     profile (angle 0). One flat map of the grid (cumulative chord lengths along its lines, the
     layout before session 8) made the layer 5 % (−0.13 rad) and 15 % (−0.3 rad) too compliant

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fegear.assembly import involute_assembly
+from fegear.geometry.pair_placement import involute_assembly
 from fegear.ltca.grid import PairCells, take_cells
 from fegear.ltca.warm import Footprint, _relative_points, likely_cells, ring_cells
 

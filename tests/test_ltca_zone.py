@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fegear.assembly import involute_assembly
 from fegear.errors import InputError
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import involute_assembly
 from fegear.ltca.zone import contact_zone
 from fegear.tca import TCA, TCAOptions, reference_phase
 
@@ -109,8 +109,8 @@ def test_a_load_beyond_the_zone_grows_it_and_models_the_new_pair():
     rated load (lag x lever 9.5 µm) cannot close it, twice the load can. The cycle must see that
     the lag closes a pair it left out, rebuild the sectors on the exact zone that holds it and
     solve again: nothing left out, equilibrium kept."""
-    from fegear.assembly import InstallationErrors, face_gear_assembly
     from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember
+    from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly
     from fegear.ltca import LTCAOptions, run_ltca
 
     fg = FaceGearMember(FaceGearDesign())

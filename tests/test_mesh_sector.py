@@ -270,7 +270,7 @@ def test_the_dgamma_face_gear_sector_meshes_with_hxt_first_time():
     Whether the surface mesher makes that triangle depends on the host's floating point (the
     AVX-512 host of session 10 made none: 0 fixed), so the test asks for what must hold on
     every host: one attempt, HXT, and a valid mesh."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.ltca import LTCAOptions
     from fegear.ltca.analysis import cycle_zone
     from fegear.pipeline.pair import build_pair

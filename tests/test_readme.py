@@ -171,9 +171,9 @@ def test_case_file_reference_is_the_schema():
 
 
 def test_the_case_file_reference_page_is_generated_from_the_schema():
-    """docs/case_files.md is what ``python -m fegear.case`` writes from the declarations (the
+    """docs/case_files.md is what ``python -m fegear.case_files`` writes from the declarations (the
     validator reads the same declarations, so the page cannot drift from what is accepted)."""
-    from fegear.case import reference
+    from fegear.case_files import reference
 
     page = (REPO / "docs" / "case_files.md").read_text(encoding="utf-8")
-    assert page == reference(), "regenerate: python -m fegear.case > docs/case_files.md"
+    assert page == reference(), "regenerate: python -m fegear.case_files > docs/case_files.md"

@@ -53,6 +53,7 @@ def test_main_job_runs_the_seed_face_gear_at_hybrid(tmp_path, monkeypatch):
     """``fegear run`` with no case: the seed face gear at hybrid level 0 (the run itself, ~1 min
     cold, is ``test_gear_cli.test_no_argument_main_job_writes_all_outputs``, slow): here the
     case and fidelity that reach the analysis, and the summary that records them."""
+    import fegear.api.runner as runner
     import fegear.pipeline.run as gear_run
     from fegear.output.gear_output import gear_summary
 
@@ -62,7 +63,7 @@ def test_main_job_runs_the_seed_face_gear_at_hybrid(tmp_path, monkeypatch):
         seen["case"] = gear_run._override(case, fidelity, level)
         raise KeyboardInterrupt  # stop before the analysis
 
-    monkeypatch.setattr(gear_run, "run_gear_case", fake_run)
+    monkeypatch.setattr(runner, "run_gear_case", fake_run)  # what fegear.run (the CLI) calls
     monkeypatch.chdir(tmp_path)
     assert main(["run", "-q"]) == 130
     case = seen["case"]
@@ -120,10 +121,10 @@ def test_spiral_bevel_p_max_is_the_hertz_value_of_its_most_loaded_interior_posit
     """Spiral bevel nominal at hybrid (the case as shipped): ``cycle.p_max_MPa`` within 10 % of
     the closed-form Hertz peak of its most loaded interior position (force of the solve, relative
     curvatures of the TCA at that pair's contact point), the edge value reported separately."""
-    from fegear.case import load_case
-    from fegear.hertz import effective_modulus, hertz_point
+    from fegear.case_files import load_case
     from fegear.ltca import LTCAOptions
     from fegear.ltca.cycle import cycle_tca
+    from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_point
     from fegear.pipeline.pair import build_pair
 
     out = tmp_path / "out"
@@ -211,7 +212,7 @@ def test_tip_clearance_of_the_error_free_pairs():
     """The clearance the interference test is measured against: exact for the spur pair (centre
     distance less tip radius less root radius), and both tips of the face gear clear by the
     dedendum less the addendum."""
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.pipeline.pair import build_pair
     from fegear.tca.engagement import tip_root_clearance
 
@@ -283,7 +284,7 @@ def test_handover_of_a_conjugate_pair_is_its_contact_ratio():
     interior contact over the whole cycle."""
     from dataclasses import replace
 
-    from fegear.case import load_case
+    from fegear.case_files import load_case
     from fegear.pipeline.pair import build_pair
     from fegear.tca import TCA, TCAOptions, reference_phase
     from fegear.tca.engagement import handover
@@ -354,8 +355,8 @@ def _pair(k, share, p_int=None, p_edge=None, edges=(), resolved=True):
 
 
 def _cycle(positions):
-    from fegear.contact import ContactSolution
     from fegear.ltca.results import LoadedCycle, LoadedPosition
+    from fegear.mechanics.contact import ContactSolution
 
     sol = ContactSolution(np.zeros(0), np.zeros(0), np.zeros(0, bool), 0.0, 0, 0.0, 0.0, 0.0, 0.0)
     pos = tuple(

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import pytest
 
-from fegear.case import SECTIONS as HERTZ_SECTIONS
-from fegear.case import parse_case
+from fegear.case_files import parse_case
 from fegear.errors import InputError
 from fegear.io import gear_case as gc
 from fegear.io.schema import INTEGER, NUMBER, Key, Range
+from fegear.scenes.hertz_case import SECTIONS as HERTZ_SECTIONS
 
 SEED_BEVEL = {
     "case": {"kind": "spiral_bevel"},

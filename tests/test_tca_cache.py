@@ -8,8 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, involute_assembly
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, involute_assembly
 from fegear.tca import TCA, TCAOptions, reference_phase
 from fegear.tca.cached import cached_tca
 

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 import fegear
-from fegear.assembly import involute_assembly
 from fegear.geometry import InvoluteMember
+from fegear.geometry.pair_placement import involute_assembly
 from fegear.geometry.transforms import apply_points, apply_vectors
-from fegear.hertz import hertz_point_radii
+from fegear.mechanics.hertz_closed_form import hertz_point_radii
 from fegear.pipeline.pair import build_pair
 from fegear.tca import TCA, TCAOptions, reference_phase
 from fegear.tca.ellipse import cycle_record, ellipses, outline, record

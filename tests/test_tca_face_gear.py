@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, face_gear_assembly
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly
 from fegear.tca import TCAOptions, flank_map, run_tca
 
 FG = FaceGearMember(FaceGearDesign())

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from fegear.assembly import InstallationErrors, involute_assembly
 from fegear.geometry import InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, involute_assembly
 from fegear.tca import (
     ARCSEC,
     TCA,

@@ -1,6 +1,7 @@
 """The rows of docs/validation.md as tests: fegear against references computed without the solver.
 
-The references (:mod:`fegear.validation.iso6336`, :mod:`fegear.hertz`) are checked against
+The references (:mod:`fegear.validation.iso6336`, :mod:`fegear.mechanics.hertz_closed_form`) are
+checked against
 hand-computed numbers and each other; each row then runs fegear (:mod:`fegear.validation.rows`)
 at the fidelity and level its tolerance is stated for. Runs reuse the session's artefact cache:
 the FZG sectors at ``hybrid`` level 0 and the spiral bevel's TCA are those of

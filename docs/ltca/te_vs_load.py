@@ -23,8 +23,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from fegear.assembly import InstallationErrors, face_gear_assembly  # noqa: E402
 from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember  # noqa: E402
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly  # noqa: E402
 from fegear.ltca import LTCAOptions, build_models, run_ltca  # noqa: E402
 
 HERE = Path(__file__).parent

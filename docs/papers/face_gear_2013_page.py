@@ -540,7 +540,7 @@ def _dgamma(doc: dict) -> str:
 **The sign conventions side by side** (the paper's words; fegear at the moderate load, part
 `dgamma` below):
 
-{table(("", "paper", "fegear (`fegear.assembly`, `docs/tca`)"), sign_rows)}
+{table(("", "paper", "fegear (`fegear.geometry.pair_placement`, `docs/tca`)"), sign_rows)}
 
 For the same sign the two move the bearing in opposite directions: the paper's +0.02° is fegear's
 −0.02° (a shaft angle closed rather than opened, or the error taken about the other sense of the

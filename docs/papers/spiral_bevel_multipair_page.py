@@ -92,7 +92,7 @@ This page checks them on fegear's reference spiral bevel `cases/spiral_bevel_nom
 machine settings synthesized by fegear) over pinion torques of
 {", ".join(f"{x:g}" for x in loads)} N·m (the case's own: 100 N·m) at fidelity `hybrid` level 0.
 fegear solves every candidate pair's contact cells together under the torque balance
-(`fegear.contact`): a pair carries load where the elastic approach closes its unloaded
+(`fegear.mechanics.contact`): a pair carries load where the elastic approach closes its unloaded
 separation, so the number of pairs comes out of the active set, as in the paper.
 
 The page is generated: `{CMD}` runs both parts and rewrites it ({seconds_text(doc, ORDER)} of

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fegear.assembly import InstallationErrors, face_gear_assembly, involute_assembly
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.pair_placement import InstallationErrors, face_gear_assembly, involute_assembly
 from fegear.tca import TCAOptions, run_tca
 from fegear.tca.plots import plot_assembly_conventions, plot_paths, plot_pattern, plot_te
 
@@ -95,7 +95,7 @@ def spiral_bevel() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from fegear.assembly import spiral_bevel_assembly
+    from fegear.geometry.pair_placement import spiral_bevel_assembly
     from fegear.geometry.spiral_bevel import SpiralBevelPair
     from fegear.tca.bevel import cycle_angles, error_effects, path_angle_on_gear, te_parabola
 

@@ -24,7 +24,7 @@ the headline numbers and the pattern shift), :func:`plot_te` and :func:`plot_pat
 
 from fegear.api.compare import plot_patterns, plot_te, table
 from fegear.api.gear_result import GearResult
-from fegear.api.hertz_result import HertzResult
+from fegear.api.hertz_scene_result import HertzResult
 from fegear.api.runner import Progress, load_case, run
 from fegear.results.model import Checks, Cycle, Excluded, PairLoad, Position
 

@@ -12,6 +12,8 @@ import numpy as np
 
 from fegear.api.gear_result import GearResult
 from fegear.errors import InputError
+from fegear.io.gear_case import error_fields
+from fegear.store.files import atomic_write
 
 __all__ = ["plot_patterns", "plot_te", "table"]
 
@@ -44,8 +46,6 @@ def table(
         pattern centre ``face`` and ``profile`` (mm, :class:`~fegear.output.flank_view.FlankFrame`)
         and their shifts ``Δface``, ``Δprofile`` against the reference ("—": not reported).
     """
-    from fegear.io.gear_case import error_fields
-
     if not results:
         raise InputError("results", "{}", "at least one result")
     if member not in ("pinion", "gear"):
@@ -87,8 +87,6 @@ def table(
 
 def _savefig(fig, path: str | Path) -> Path:
     import matplotlib.pyplot as plt
-
-    from fegear.store.files import atomic_write
 
     fig.tight_layout()
     out = atomic_write(Path(path), lambda q: fig.savefig(q, format="png", dpi=110))

@@ -12,8 +12,12 @@ import numpy as np
 
 from fegear.errors import InputError
 from fegear.io.gear_case import GearCase
+from fegear.output.flank_view import plot_flank_pattern
+from fegear.output.gear_output import write_gear_outputs
+from fegear.results.build import build_result
 from fegear.results.model import Checks, Cycle, GearRunResult, PatternCentre, Position
 from fegear.results.summary import summary_document, summary_warnings
+from fegear.store.outputs import inspect_output_folder, output_run
 
 if TYPE_CHECKING:  # the run and its flank views: the pipeline and the writers, loaded on use
     from fegear.output.gear_output import FlankViews
@@ -113,9 +117,6 @@ class GearResult:
             ``folder`` cannot be written (a file, or no permission), or holds other files and
             ``overwrite`` is False.
         """
-        from fegear.output.gear_output import write_gear_outputs
-        from fegear.store.outputs import inspect_output_folder, output_run
-
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
             return tuple(write_gear_outputs(out, self.run, self._views, self.model))
 
@@ -154,8 +155,6 @@ class GearResult:
             A bad ``member``, or a fidelity without contact cells (``tca``, ``hertz``: use
             :func:`plot_patterns` for the contact path).
         """
-        from fegear.output.flank_view import plot_flank_pattern
-
         if member not in ("pinion", "gear"):
             raise InputError("member", member, "'pinion' or 'gear'")
         if not self._views.patches or (self.run.kind is not None and not self.run.kind.cells):
@@ -174,8 +173,6 @@ class GearResult:
 def gear_result(run: GearRun, views: FlankViews) -> GearResult:
     """The :class:`GearResult` of a run: its result model, built once
     (:func:`fegear.results.build_result`)."""
-    from fegear.results.build import build_result
-
     model = build_result(run, views.pattern)
     return GearResult(
         case=run.case,

@@ -8,11 +8,16 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from fegear.api.gear_result import GearResult, gear_result
-from fegear.api.hertz_result import HertzResult, run_hertz
-from fegear.case import HertzCase
-from fegear.case import load_case as _load_case
+from fegear.api.hertz_scene_result import HertzResult, run_hertz
+from fegear.case_files import load_case as _load_case
 from fegear.errors import InputError
 from fegear.io.gear_case import ANALYSIS, FIDELITIES, N_LEVELS, GearCase
+from fegear.output.gear_output import flank_views
+from fegear.pipeline.pair import build_pair
+from fegear.pipeline.run import run_gear_case
+from fegear.scenes.hertz_case import HertzCase
+from fegear.store.cache import cache_root, check_cache_root
+from fegear.store.files import clean_stale_temps
 
 __all__ = ["Progress", "load_case", "run"]
 
@@ -55,9 +60,6 @@ def _clean_cache_temps() -> None:
     """Remove the temporary files that interrupted writes left in the artefact cache
     (:func:`fegear.store.files.clean_stale_temps`: their writer is gone), once per process and
     cache folder."""
-    from fegear.store.cache import cache_root
-    from fegear.store.files import clean_stale_temps
-
     root = cache_root()
     if str(root) in _CLEANED:
         return
@@ -124,8 +126,6 @@ def run(
     FegearError
         The analysis failed (mesh, solver).
     """
-    from fegear.store.cache import check_cache_root
-
     check_cache_root()
     _clean_cache_temps()
     if isinstance(case, HertzCase):
@@ -135,10 +135,6 @@ def run(
     if not isinstance(case, GearCase):
         raise InputError("case", type(case).__name__, "a case from fegear.load_case")
     from dataclasses import replace
-
-    from fegear.output.gear_output import flank_views
-    from fegear.pipeline.pair import build_pair
-    from fegear.pipeline.run import run_gear_case
 
     if study is not None:
         raise InputError("study", study, "absent for a gear case (a Hertz-scene option)")

@@ -1,7 +1,8 @@
 """Full-FE decks of fegear's problems for CalculiX (and Abaqus), and their results read back.
 
 - :func:`export_ccx`: a case (the Hertz scene, or a gear pair at chosen positions) as
-  ready-to-run ``.inp`` decks (:mod:`fegear.export.hertz_deck`, :mod:`fegear.export.gear_deck`);
+  ready-to-run ``.inp`` decks (:mod:`fegear.export.hertz_scene_deck`,
+  :mod:`fegear.export.gear_deck`);
 - :func:`~fegear.export.ccx_run.run_ccx`: runs ``ccx`` on one, with its wall time and memory;
 - :func:`~fegear.export.ccx_results.read_results`: load shares, p_max, patch semi-axes, TE.
 
@@ -40,6 +41,7 @@ DEFAULT_GEAR_ELEMENT_MM = 0.5
 def position_angle(case, index: int) -> float:
     """Pinion angle (rad) of position ``index`` of the case's cycle of ``n_positions``
     (``−π/N1 + 2π index / (N1 n)``: the positions of ``fegear run``)."""
+    # local: the pipeline pulls scipy; the `fegear` command's parser imports this package
     from fegear.pipeline.pair import build_pair
 
     n = case.n_positions
@@ -63,7 +65,7 @@ def export_ccx(
     Parameters
     ----------
     case
-        A :class:`~fegear.case.HertzCase` (one deck) or a
+        A :class:`~fegear.scenes.hertz_case.HertzCase` (one deck) or a
         :class:`~fegear.io.gear_case.GearCase` (one deck per pinion angle of ``phi1``).
     element_mm
         Contact element size (mm). Default: the Hertz scene's level (twice its cell size, as
@@ -76,10 +78,13 @@ def export_ccx(
     level
         Gear pairs: sector mesh level away from the contact (default: the case's).
     """
-    from fegear.case import HertzCase
+    # local: the scene and the decks pull scipy, scikit-fem and meshio; the `fegear` command's
+    # parser imports this package
+    from fegear.scenes.hertz_case import HertzCase
 
     if isinstance(case, HertzCase):
-        from fegear.export.hertz_deck import hertz_deck
+        # local: as above
+        from fegear.export.hertz_scene_deck import hertz_deck
         from fegear.scenes.hertz_scene import (
             CELLS_ACROSS_MINOR,
             ELEMENT_TO_CELL,
@@ -93,7 +98,7 @@ def export_ccx(
             element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[case.level]
         return [hertz_deck(case.scene, element_mm, name=f"{case.name}_{element_mm:.3g}mm")
                 .write(out)]  # fmt: skip
-    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck
+    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck  # local: as above
 
     if not phi1:
         raise InputError("positions", [], "at least one position of a gear pair")

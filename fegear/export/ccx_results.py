@@ -18,11 +18,12 @@ Quantities (the same definitions as fegear's, so that the two compare):
   (pinion) flank (``s₂`` the gear's driving sense about ``z``; the force on the gear is the
   opposite one).
 - **p_max**: the largest nodal ``CPRESS`` of a pair, and the recovered peak of
-  :func:`fegear.patch.measure_patch` on the nodal forces (``CPRESS`` times the node's tributary
+  :func:`fegear.mechanics.patch.measure_patch` on the nodal forces (``CPRESS`` times the node's
+  tributary
   area on its slave faces: a third of each of the four straight sub-triangles of a six-node
   face); **patch semi-axes**: ``sqrt(5 λ)`` of the second moments of those nodal forces in the
-  patch's tangent plane (:mod:`fegear.patch`: exact for a Hertz distribution). For the Hertz
-  quarter model the patch is mirrored about both symmetry planes first.
+  patch's tangent plane (:mod:`fegear.mechanics.patch`: exact for a Hertz distribution). For the
+  Hertz quarter model the patch is mirrored about both symmetry planes first.
 - **Loaded TE** = unloaded TE (the TCA's, in the deck's record) − ``θ``, ``θ = −s₂ u_z`` of
   ``ROT_GEAR`` (the lag of the gear, rad; arcsec in the result): fegear's definition (the lag
   of member 2 is positive when the driven member falls behind, and a lag makes the TE more
@@ -41,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fegear.errors import FegearError, InputError
-from fegear.patch import measure_patch
+from fegear.mechanics.patch import measure_patch
 
 __all__ = ["CcxPair", "CcxResult", "read_results", "read_frd_contact", "read_dat"]
 
@@ -71,7 +72,7 @@ class CcxPair:
     p_max_MPa
         Largest nodal contact pressure.
     p_peak_MPa
-        Recovered peak pressure (:func:`fegear.patch.measure_patch`).
+        Recovered peak pressure (:func:`fegear.mechanics.patch.measure_patch`).
     semi_major_mm, semi_minor_mm
         Equivalent-ellipse semi-axes of the patch (0 without contact).
     n_active

@@ -14,6 +14,7 @@ import math
 import sys
 
 from fegear.errors import InputError
+from fegear.export import export_ccx, find_ccx, position_angle, read_results, run_ccx
 
 __all__ = ["add_parser", "run"]
 
@@ -52,9 +53,10 @@ def _floats(text: str, option: str) -> list[float]:
 
 def run(args: argparse.Namespace) -> int:
     """Run the subcommand; the exit code."""
+    # local: the API and the Hertz case pull scipy and scikit-fem (~2 s); the `fegear` command
+    # builds its parser from this module
     from fegear.api import load_case
-    from fegear.case import HertzCase
-    from fegear.export import export_ccx, position_angle, read_results, run_ccx
+    from fegear.scenes.hertz_case import HertzCase
 
     say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     case = load_case(args.case)
@@ -68,8 +70,6 @@ def run(args: argparse.Namespace) -> int:
     elif not isinstance(case, HertzCase):
         raise InputError("--positions", None, "positions of the gear pair (or --phi1-deg)")
     if args.run:
-        from fegear.export import find_ccx
-
         find_ccx()  # a missing ccx is said before any meshing
     paths = export_ccx(case, args.out, args.element_mm, phi1, args.reach_mm, args.level)
     for p in paths:

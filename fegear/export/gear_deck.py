@@ -51,7 +51,13 @@ from fegear.export.deck import (
 from fegear.export.flank_projection import flank_projection
 from fegear.export.inp import Tet10Body, tet10_body, write_body
 from fegear.geometry.transforms import inverse
+from fegear.ltca import LTCAOptions
+from fegear.ltca.analysis import cycle_zone
+from fegear.ltca.cycle import cycle_tca
+from fegear.ltca.zone import contact_zone
+from fegear.mesh.sector import sector_mesh
 from fegear.mesh.sector_geometry import sector_frame
+from fegear.pipeline.pair import build_pair
 from fegear.tca.results import ARCSEC
 
 __all__ = ["gear_deck", "DEFAULT_REACH_MM"]
@@ -134,13 +140,6 @@ def gear_deck(
     InputError
         A bad size, or a position without contact.
     """
-    from fegear.ltca import LTCAOptions
-    from fegear.ltca.analysis import cycle_zone
-    from fegear.ltca.cycle import cycle_tca
-    from fegear.ltca.zone import contact_zone
-    from fegear.mesh.sector import sector_mesh
-    from fegear.pipeline.pair import build_pair
-
     if not (isinstance(element_mm, (int, float)) and math.isfinite(element_mm) and element_mm > 0):
         raise InputError("element_mm", element_mm, "a finite size > 0 (mm)")
     if not (math.isfinite(reach_mm) and reach_mm > 0):

@@ -30,6 +30,7 @@ import scipy.sparse as sp
 import skfem
 
 from fegear.errors import InputError
+from fegear.fem.assembly import elasticity_stiffness
 
 __all__ = ["ElasticBody", "assemble_body", "boundary_dofs"]
 
@@ -68,8 +69,6 @@ class ElasticBody:
     @cached_property
     def K(self) -> sp.csr_matrix:  # noqa: N802 (the stiffness matrix is K)
         """Stiffness on the free DOFs (N/mm), assembled once."""
-        from fegear.fem.assembly import elasticity_stiffness
-
         t0 = time.perf_counter()
         K = elasticity_stiffness(self.mesh, self.E, self.nu)
         Kf = K[self.free][:, self.free].tocsr()

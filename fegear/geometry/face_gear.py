@@ -52,6 +52,7 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
 from ..errors import DesignError, SolverError
+from .design_checks import validate_face_gear
 from .face_gear_fillet import FilletLimit, TipEdge
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, generate
 from .involute import InvoluteDesign, InvoluteMember
@@ -65,7 +66,6 @@ from .surface import (
     finite_difference_curvatures,
 )
 from .transforms import rot_y, rot_z, translation
-from .validation import validate_face_gear
 
 __all__ = ["FaceGearDesign", "FaceGearMember", "ShaperTool", "closed_form_point"]
 

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import MeshError
+from .design_checks import validate_involute
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, Translation, generate
 from .generation import tool_sample as _tool_sample
 from .surface import BlankOutline, ConeLine, FlankBoundaries, FlankCoordinates, FlankSurface, Side
@@ -73,8 +74,6 @@ class InvoluteDesign:
     tip_relief_start_mm: float | None = None
 
     def __post_init__(self) -> None:
-        from .validation import validate_involute
-
         validate_involute(self)
 
 

@@ -63,7 +63,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
 from ..errors import DesignError, InputError, SolverError
-from .generation import Envelope, generate
+from .generation import Envelope, Fixed, Rotation, Translation, generate
 from .spiral_bevel_settings import (
     ARCSEC,
     EdgeRadius,
@@ -936,7 +936,6 @@ class _Step:
 
 def _compile(factors) -> tuple[_Step, ...]:
     """Compile a :class:`~fegear.geometry.generation.Motion` chain (constant factors merged)."""
-    from .generation import Fixed, Rotation, Translation
 
     def der(c: tuple[float, ...]) -> tuple[float, ...]:
         return tuple(k * c[k] for k in range(1, len(c)))

@@ -24,11 +24,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fegear.assembly import InstallationErrors
 from fegear.errors import InputError
 from fegear.geometry.cylindrical import RELIEF_SHAPES
 from fegear.geometry.face_gear import FaceGearDesign
 from fegear.geometry.involute import InvoluteDesign
+from fegear.geometry.pair_placement import InstallationErrors
 from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
 from fegear.io.schema import (
     BOOLEAN,
@@ -367,7 +367,7 @@ PAIR_SECTIONS: dict[str, Section] = {
 }
 _INTERSECTING = "intersecting axes (face gear, spiral bevel)"
 _PARALLEL = "parallel axes (spur, cylindrical)"
-#: ``[errors]`` by axis arrangement (sign conventions: :mod:`fegear.assembly`).
+#: ``[errors]`` by axis arrangement (sign conventions: :mod:`fegear.geometry.pair_placement`).
 ERROR_KEYS: dict[str, tuple[Key, ...]] = {
     "intersecting": (
         Key(
@@ -530,7 +530,7 @@ def sections(kind: str) -> tuple[Section, ...]:
     errors = Section(
         "errors",
         ERROR_KEYS["parallel" if kind in PARALLEL_KINDS else "intersecting"],
-        "Installation errors, all 0 by default (sign conventions: fegear.assembly).",
+        "Installation errors, all 0 by default (sign conventions: fegear.geometry.pair_placement).",
     )
     return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL, CONTACT)
 
@@ -657,7 +657,8 @@ class GearCase:
             ``n_positions``, ``n_teeth`` (None: automatic), ``backend``, ``root_stress``,
             ``E_MPa``, ``nu``,
             ``speed_rpm`` (rpm, recorded only), ``errors`` (an
-            :class:`~fegear.assembly.InstallationErrors` or a mapping of the ``[errors]`` keys:
+            :class:`~fegear.geometry.pair_placement.InstallationErrors` or a mapping of the
+            ``[errors]`` keys:
             it replaces all of them, the ones not given are 0), ``pair`` (the whole ``[pair]``
             table: ``case.replace(pair={**case.pair, "module_mm": 5.0})``), ``contact`` (a
             :class:`~fegear.options.ContactOptions` or a mapping of the ``[contact]`` keys: it
@@ -735,7 +736,8 @@ class GearCase:
             parallel axes (spur) ``da_mm`` (centre distance, mm), ``f_sigma_delta_mm``,
             ``f_sigma_beta_mm`` (axis-parallelism errors in and out of the plane of the axes
             over the face width, mm), ``dA1_mm``, ``dA2_mm``. Sign conventions:
-            :mod:`fegear.assembly`. ``case.replace(errors={})`` sets all of them to 0.
+            :mod:`fegear.geometry.pair_placement`. ``case.replace(errors={})`` sets all of them to
+            0.
 
         Raises
         ------

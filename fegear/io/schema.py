@@ -14,7 +14,7 @@ declarations
 - write the case-file reference (:func:`reference_markdown`, ``docs/case_files.md``).
 
 Rules between keys (an outer radius above the inner one, exactly one torque) stay in the
-parsers of the case kinds (:mod:`fegear.io.gear_case`, :mod:`fegear.case`).
+parsers of the case kinds (:mod:`fegear.io.gear_case`, :mod:`fegear.scenes.hertz_case`).
 """
 
 from __future__ import annotations

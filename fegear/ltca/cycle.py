@@ -325,7 +325,7 @@ def run_ltca(
     pinion, gear
         Generated members.
     assembly
-        The assembled pair (:mod:`fegear.assembly`), with its installation errors.
+        The assembled pair (:mod:`fegear.geometry.pair_placement`), with its installation errors.
     torque2_Nmm
         Resisting torque on member 2 (N·mm, > 0).
     options

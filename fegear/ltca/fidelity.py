@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from fegear.errors import InputError
-from fegear.ltca.hertz_model import solve_position_hertz
+from fegear.ltca.hertz_fidelity import solve_position_hertz
 from fegear.ltca.hybrid import hybrid_compliance
 from fegear.ltca.model import cell_load_operators, member_compliance
 from fegear.ltca.position import solve_position
@@ -148,7 +148,7 @@ class Hybrid(FE):
 
 class Hertz(FE):
     """``hertz``: per-pair Hertz laws with the lumped FE compliance of each pair
-    (:mod:`fegear.ltca.hertz_model`, which reads the FE compliance of the cells near each
+    (:mod:`fegear.ltca.hertz_fidelity`, which reads the FE compliance of the cells near each
     pair's contact point: :meth:`FE.compliance`); no contact cells are reported."""
 
     name = "hertz"

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from fegear.assembly import tooth_transform
+from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.transforms import apply_points, apply_vectors, compose
 from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
@@ -218,7 +218,7 @@ def _patch_coordinates(centers: Array, normals: Array, edges: Array, origin: Arr
     """``(n, 2)`` mm: cell centres in the tangent plane of the cell nearest ``origin`` (the
     pair's closest point), along its ``ξ`` edge and the in-plane normal to it on the ``η`` side,
     each stretched to its chord from that cell (the rule of
-    :func:`fegear.halfspace.tangent_layout`), less their mean.
+    :func:`fegear.mechanics.halfspace.tangent_layout`), less their mean.
 
     One flat map of a curved flank cannot be exact everywhere; this one is exact at the patch
     (it is laid where the contact is) and keeps the distances from it. Cumulative chord lengths

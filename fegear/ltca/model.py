@@ -34,6 +34,7 @@ from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.mesh.sector import SectorMesh
+from fegear.store.cache import cached_file
 
 __all__ = [
     "MemberModel",
@@ -217,7 +218,6 @@ def _facet_dofs(basis, facets: np.ndarray) -> np.ndarray:
 
 def _cached_layer_tets(mesh, facets: np.ndarray, depth: float, key: dict) -> np.ndarray:
     """:func:`_layer_tets`, read from the cache when the same mesh was layered before (0.2 s)."""
-    from fegear.store.cache import cached_file
 
     def build(path) -> None:
         with open(path, "wb") as fh:

@@ -12,7 +12,8 @@ At each mesh position:
    on the member's cached operator (the force of a cell acts along ``−n1`` on the pinion and
    ``+n1`` on the gear, ``n1`` the pinion's outward normal); cells of different pairs are coupled
    through the bodies;
-4. :func:`fegear.contact.solve_contact` solves ``d = g − θ h + C F ≥ 0, F ≥ 0, F·d = 0`` with
+4. :func:`fegear.mechanics.contact.solve_contact` solves ``d = g − θ h + C F ≥ 0, F ≥ 0, F·d = 0``
+with
    torque balance ``hᵀF = T2``: ``θ`` is the elastic lag of member 2, and the number of pairs in
    contact is whatever the active set says;
 5. ``g_max`` is checked afterwards: a coarse TCA cell left out (separation above ``g_max``) whose
@@ -43,7 +44,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from fegear.contact import solve_contact
 from fegear.ltca.degenerate import position_status
 from fegear.ltca.edges import edge_split
 from fegear.ltca.grid import PairCells, missing_pairs, pair_cells, take_cells
@@ -58,7 +58,8 @@ from fegear.ltca.results import (
 )
 from fegear.ltca.warm import active_guess, footprint, likely_cells, ring_cells
 from fegear.ltca.zone import left_out_pairs
-from fegear.patch import measure_patch
+from fegear.mechanics.contact import solve_contact
+from fegear.mechanics.patch import measure_patch
 from fegear.tca import TCA
 from fegear.tca.results import ARCSEC, PositionResult
 

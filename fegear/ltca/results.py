@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fegear.contact import ContactSolution
 from fegear.ltca.grid import PairCells
 from fegear.ltca.zone import ContactZone
+from fegear.mechanics.contact import ContactSolution
 
 __all__ = [
     "DEGENERATE_SHARE",
@@ -61,7 +61,7 @@ class PairContact:
     p_max_MPa
         Largest cell pressure.
     p_peak_MPa
-        Recovered peak pressure (:func:`fegear.patch.measure_patch`).
+        Recovered peak pressure (:func:`fegear.mechanics.patch.measure_patch`).
     semi_major_mm, semi_minor_mm
         Equivalent-ellipse semi-axes from the second moments of the pressure.
     n_active

@@ -1,7 +1,8 @@
 """Warm start of the contact solver from a neighbouring solution (same position on a finer grid,
 or the previous mesh position).
 
-The active-set solver (:func:`fegear.contact.solve_contact`) needs about as many factorisations
+The active-set solver (:func:`fegear.mechanics.contact.solve_contact`) needs about as many
+factorisations
 as it takes to grow the active set from one cell to the patch (measured on the seed face gear,
 ``hybrid`` level 0: 9 per solve). The patch of a pair moves little between two solves: on a
 refined grid of the same position it stays where it was, and from one mesh position to the next
@@ -25,10 +26,10 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial import cKDTree
 
-from fegear.assembly import Assembly, tooth_transform
-from fegear.contact import ContactSolution
+from fegear.geometry.pair_placement import Assembly, tooth_transform
 from fegear.geometry.transforms import apply_points, compose, inverse
 from fegear.ltca.grid import PairCells
+from fegear.mechanics.contact import ContactSolution
 
 __all__ = ["Footprint", "footprint", "active_guess", "likely_cells", "ring_cells"]
 

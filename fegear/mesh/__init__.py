@@ -1,5 +1,3 @@
-"""gmsh meshes of the bodies in contact, and their content-hash cache."""
-
-from fegear.store.cache import cache_dir, cached_file, content_hash
-
-__all__ = ["cache_dir", "cached_file", "content_hash"]
+"""gmsh meshes of the bodies in contact: the sector meshes of the gear members
+(:mod:`fegear.mesh.sector`) and the Hertz scene's bodies (:mod:`fegear.mesh.hertz_scene_bodies`).
+They are cached by content in :mod:`fegear.store.cache`."""

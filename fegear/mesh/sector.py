@@ -70,6 +70,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.store.files import atomic_write
+
 from ..errors import InputError, MeshError
 from ..geometry.surface import GeneratedMember, Side
 from ..store.cache import Entry, cached_record
@@ -753,8 +755,6 @@ def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray
     ``$Entities`` section; the arrays are kept next to it in ``<name>.arrays.npz`` (10 ms to read;
     written atomically, re-made if older than the ``.msh``).
     """
-    from fegear.store.files import atomic_write
-
     side = path.with_name(path.stem + ".arrays.npz")
     if side.exists() and side.stat().st_mtime >= path.stat().st_mtime:
         with np.load(side) as z:

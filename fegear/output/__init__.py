@@ -4,6 +4,6 @@
 :mod:`fegear.results`), :mod:`fegear.output.vtk` (the VTK series), :mod:`fegear.output.gear_plots`
 and :mod:`fegear.output.pattern_plot` (the PNGs), :mod:`fegear.output.flank_view` and
 :mod:`fegear.output.flank_vtp` (the flank bearing patterns: per-flank frames, patches, pattern
-centres, their files), :mod:`fegear.output.hertz_output` (the Hertz validation scene). Files are
-written atomically (:mod:`fegear.store.files`).
+centres, their files), :mod:`fegear.output.hertz_scene_output` (the Hertz validation scene). Files
+are written atomically (:mod:`fegear.store.files`).
 """

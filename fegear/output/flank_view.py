@@ -40,8 +40,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.geometry.pair_placement import tooth_transform
+from fegear.geometry.transforms import apply_points, apply_vectors, compose, inverse
 from fegear.results.model import PatternCentre
 from fegear.store.files import atomic_write
+from fegear.tca.solve import line_hit
+from fegear.tca.surfaces import flank_map
 
 __all__ = [
     "FlankFrame",
@@ -151,8 +155,6 @@ def _face_ends(bounds) -> tuple[str, str]:
 
 def _maps(run):
     """The exact flank maps of both members (the TCA's)."""
-    from fegear.tca.surfaces import flank_map
-
     asm = run.assembly
     return {
         "pinion": flank_map(run.pair.pinion, asm.side1),
@@ -214,8 +216,6 @@ class _Projector:
         return self.a[i], self.b[i]
 
     def __call__(self, P: Array, N: Array, a0: Array, b0: Array):
-        from fegear.tca.solve import line_hit
-
         a, b, _, p, _, ok = line_hit(self.fm, a0, b0, P, N)
         u, v = self.fm.flank(a, b, p)
         return np.asarray(u, float), np.asarray(v, float), a, b, ok
@@ -229,9 +229,6 @@ def flank_patches(run, maps=None, frames=None) -> list[dict[str, FlankPatch]]:
     The Newton solves of all cells of all positions run as one batch per member and stage
     (gear cell centres, then the corners of both members from their centres).
     """
-    from fegear.assembly import tooth_transform
-    from fegear.geometry.transforms import apply_points, apply_vectors, compose, inverse
-
     cyc = run.cycle
     if cyc is None:
         return []

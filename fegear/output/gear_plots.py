@@ -11,10 +11,12 @@ import numpy as np
 from fegear.output.figure import pyplot as _plt
 from fegear.output.figure import run_title as _title
 from fegear.output.figure import save_png as _save
+from fegear.output.p_max_plot import save_p_max
 from fegear.output.pattern_plot import plot_loaded_pattern, plot_unloaded_pattern
 from fegear.pipeline.run import GearRun
 from fegear.results.model import GearRunResult
 from fegear.store.files import atomic_write
+from fegear.tca.plots import plot_te
 
 __all__ = ["loaded_plots", "tca_plots"]
 
@@ -75,8 +77,6 @@ def _plot_load_share(out: Path, run: GearRun, result: GearRunResult) -> Path:
 def _plot_p_max(out: Path, run: GearRun, result: GearRunResult) -> Path:
     """``p_max.png`` (:mod:`fegear.output.p_max_plot`: the values away from the edges as lines,
     the singular edge values marked apart)."""
-    from fegear.output.p_max_plot import save_p_max
-
     h = result.cycle
     edge = (
         f"; at the edges {h.p_max_edge_MPa:.0f} MPa (singular)"
@@ -145,8 +145,6 @@ def _plot_root_stress(out: Path, run: GearRun) -> Path:
 def tca_plots(out: Path, run: GearRun) -> list[Path]:
     """``te.png`` (the unloaded TE) and ``bearing_pattern.png`` (paint thickness) of an unloaded
     run."""
-    from fegear.tca.plots import plot_te
-
     r, name = run.tca, run.case.name
     paths = [atomic_write(out / "te.png", lambda q: plot_te({name: r}, q,
                           title=f"{name}: unloaded TE (TCA)"))]  # fmt: skip

@@ -20,7 +20,7 @@ from fegear.output.figure import run_title as _title
 from fegear.output.figure import save_png as _save
 from fegear.pipeline.run import GearRun
 from fegear.store.files import atomic_write
-from fegear.tca.plots import axis_label, draw_ellipses
+from fegear.tca.plots import axis_label, draw_ellipses, plot_pattern
 
 __all__ = ["plot_loaded_pattern", "plot_unloaded_pattern"]
 
@@ -41,8 +41,6 @@ def _unloaded_path(ax, run: GearRun, which: tuple[str, ...], color: str) -> None
 def plot_unloaded_pattern(out: Path, run: GearRun) -> Path:
     """``bearing_pattern.png`` of fidelity ``tca`` (:func:`fegear.tca.plots.plot_pattern` with
     the run's ellipses)."""
-    from fegear.tca.plots import plot_pattern
-
     name = run.case.name
     return atomic_write(
         out / "bearing_pattern.png",

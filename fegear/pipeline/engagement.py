@@ -15,8 +15,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fegear.errors import DesignError, InputError
+from fegear.geometry.pair_placement import InstallationErrors
 from fegear.io.gear_case import GearCase, error_fields
 from fegear.pipeline.pair import GearPair, assemble
+from fegear.tca.engagement import cached_handover, jamming, tip_root_clearance
+from fegear.tca.path import cached_contact_path
 
 __all__ = ["INTERFERENCE_TOL_MM", "Engagement", "check_engagement", "check_clearance"]
 
@@ -87,9 +90,6 @@ def check_clearance(case: GearCase, pair: GearPair):
     if the error-free pair already interferes)."""
     from dataclasses import replace
 
-    from fegear.assembly import InstallationErrors
-    from fegear.tca.engagement import tip_root_clearance
-
     c = tip_root_clearance(pair.pinion, pair.gear, pair.assembly)
     if c.interference_mm <= INTERFERENCE_TOL_MM:
         return c
@@ -123,8 +123,6 @@ def check_clearance(case: GearCase, pair: GearPair):
 def _jamming(pair: GearPair, case: GearCase) -> str:
     """The warning of a parallel-axes pair that jams (:func:`fegear.tca.engagement.jamming`),
     else ""."""
-    from fegear.tca.engagement import jamming
-
     if pair.assembly.kind != "parallel":
         return ""
     j = jamming(pair.pinion, pair.gear, case.errors)
@@ -152,9 +150,6 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
         No position of the cycle has contact: the flanks do not meet (naming the installation
         errors that separate them).
     """
-    from fegear.tca.engagement import cached_handover
-    from fegear.tca.path import cached_contact_path
-
     errs = tuple(error_fields(case))
     has = np.array([p.has_contact for p in positions], dtype=bool)
     phi1 = np.array([p.phi1 for p in positions], dtype=float)

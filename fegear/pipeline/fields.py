@@ -15,8 +15,25 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from fegear.fem.assembly import elasticity_stiffness
+from fegear.fem.elasticity import assemble_body
+from fegear.fem.stress import (
+    CONTACT_CLEARANCE_MODULES,
+    FILLET_MODULES,
+    VertexStress,
+    fillet_regions,
+    principal_stresses,
+    reactions,
+    tooth_root_stress,
+    von_mises,
+)
+from fegear.geometry.transforms import apply_points, inverse
 from fegear.linalg.solve import SparseFactor, factorize_spd
+from fegear.ltca.model import member_load_operator
+from fegear.mesh.sector import FILLET_TRIANGLES, FINE, default_zone, sector_mesh
+from fegear.mesh.sector_geometry import sector_frame
 from fegear.pipeline.pair import GearPair
+from fegear.store.cache import cached_record
 
 __all__ = ["MemberField", "displacements", "stress_sector"]
 
@@ -115,8 +132,6 @@ def _factorised(sector, body, backend: str = "auto") -> tuple[sp.csr_matrix, Spa
     """``(K_full, factor)`` of a stress sector: the full stiffness (reactions) and the
     solver on its free DOFs, from :data:`_FACTORS` when the same mesh (file), material and
     clamping were factorised before in this process."""
-    from fegear.fem.assembly import elasticity_stiffness
-
     key = (str(sector.path), body.E, body.nu, body.free.size, body.n_dofs, backend)
     if key in _FACTORS:
         _FACTORS.move_to_end(key)
@@ -136,8 +151,6 @@ def _vertex_displacements(model, body, F: Array, vdofs, backend: str) -> tuple[A
     loads before (a run repeated: no factorisation), else one factorisation for all positions
     (kept in the process, :func:`_factorised`, for the next loads on the same sector: the
     variants of a study)."""
-    from fegear.store.cache import cached_record
-
     params = {
         "mesh": model.sector.path.name if model.sector.path else repr(model.sector.parameters),
         "E": body.E,
@@ -161,8 +174,6 @@ def _vertex_displacements(model, body, F: Array, vdofs, backend: str) -> tuple[A
 def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
     """``{member tooth: (q, 3) mm}``: the centres of the loaded contact cells of a position on
     each tooth of ``member`` (its frame; gear cells moved across their gap onto its flank)."""
-    from fegear.geometry.transforms import apply_points, inverse
-
     out: dict[int, list[Array]] = {}
     if not pos.cells:
         return {}
@@ -188,10 +199,6 @@ def stress_sector(member, model, teeth: tuple[int, ...] | None, fillet_mm: float
     :class:`~fegear.ltca.model.MemberModel` without compliance operator (``op`` None): what
     :func:`fegear.ltca.model.member_load_operator` needs to load it."""
     from dataclasses import replace
-
-    from fegear.fem.elasticity import assemble_body
-    from fegear.mesh.sector import default_zone, sector_mesh
-    from fegear.mesh.sector_geometry import sector_frame
 
     p = model.sector.parameters
     n, rim = int(p["n_teeth"]), float(p.get("rim_modules", 3.0))
@@ -250,19 +257,6 @@ def displacements(
     sectors' fillets are as coarse as their level: their stresses are not the root stress).
     ``backend``: of the sparse Cholesky (:func:`fegear.linalg.solve.factorize_spd`).
     """
-    from fegear.fem.stress import (
-        CONTACT_CLEARANCE_MODULES,
-        FILLET_MODULES,
-        VertexStress,
-        fillet_regions,
-        principal_stresses,
-        reactions,
-        tooth_root_stress,
-        von_mises,
-    )
-    from fegear.ltca.model import member_load_operator
-    from fegear.mesh.sector import FILLET_TRIANGLES, FINE
-
     out = []
     n_pos = len(cycle.positions)
     fm = FILLET_MODULES if fillet_modules is None else float(fillet_modules)

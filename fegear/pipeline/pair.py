@@ -16,15 +16,21 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from fegear.assembly import (
+from fegear.errors import DesignError, InputError
+from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.cylindrical import CylindricalMember, FlankModifications, signed_helix_deg
+from fegear.geometry.design_checks import validate_involute_pair
+from fegear.geometry.pair_placement import (
     Assembly,
     InstallationErrors,
     face_gear_assembly,
     involute_assembly,
     spiral_bevel_assembly,
 )
-from fegear.errors import InputError
+from fegear.geometry.spiral_bevel import SpiralBevelPair
+from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
 from fegear.io.gear_case import PAIR_SECTIONS, GearCase
+from fegear.store.cache import cached_file
 
 __all__ = ["FAMILIES", "Family", "GearPair", "assemble", "build_pair", "family"]
 
@@ -38,7 +44,7 @@ class GearPair:
     pinion, gear
         The members (:class:`~fegear.geometry.surface.GeneratedMember`).
     assembly
-        Their :class:`~fegear.assembly.Assembly` with the case's installation errors.
+        Their :class:`~fegear.geometry.pair_placement.Assembly` with the case's installation errors.
     spiral_bevel
         The synthesized :class:`~fegear.geometry.spiral_bevel.SpiralBevelPair` (spiral bevel
         cases only, else None): what re-assembling with other errors needs.
@@ -92,8 +98,6 @@ class FaceGearFamily:
     _fields = {"n_shaper_teeth": "n_shaper"}
 
     def build(self, case: GearCase) -> GearPair:
-        from fegear.geometry import FaceGearDesign, FaceGearMember
-
         p = case.pair
         kw = {k: v for k, v in p.items() if k != "n_shaper"}
         if "n_shaper" in p:
@@ -115,10 +119,8 @@ class FaceGearFamily:
 
 def _face_gear_pinion(fg):
     """The standard (unshifted) pinion of a face-gear drive; its undercut or pointed tip
-    (:func:`fegear.geometry.validation.validate_involute`) refused naming ``pair.n_pinion`` with
+    (:func:`fegear.geometry.design_checks.validate_involute`) refused naming ``pair.n_pinion`` with
     the smallest tooth count that clears it (the pinion has no profile shift of its own)."""
-    from fegear.errors import DesignError
-
     try:
         return fg.pinion()
     except DesignError as exc:
@@ -150,9 +152,6 @@ class SpurFamily:
         return float(v[i]) if isinstance(v, list) else float(v)
 
     def build(self, case: GearCase) -> GearPair:
-        from fegear.geometry import InvoluteDesign, InvoluteMember
-        from fegear.geometry.validation import validate_involute_pair
-
         p = case.pair
         value = self._member_value
         members = []
@@ -210,13 +209,6 @@ class CylindricalFamily:
         return v[i] if isinstance(v, list) else v
 
     def build(self, case: GearCase) -> GearPair:
-        from fegear.geometry import InvoluteDesign
-        from fegear.geometry.cylindrical import (
-            CylindricalMember,
-            FlankModifications,
-            signed_helix_deg,
-        )
-
         p = case.pair
         value = self._value
         beta = float(value(p, "helix_angle_deg", 0))
@@ -320,10 +312,6 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
     (:meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.record`, JSON: no pickle); the key
     holds the code version of ``fegear.geometry`` and the numpy and scipy versions
     (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis invalidates it."""
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
-    from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
-    from fegear.store.cache import cached_file
-
     box: dict[str, Any] = {}
 
     def build(path: Path) -> None:

@@ -14,7 +14,7 @@ Fidelities available for gear pairs (``docs/fidelity.md``):
 - ``"tca"``: the rigid, unloaded TCA (:func:`fegear.tca.run_tca`): unloaded TE, contact path,
   unloaded bearing pattern. No FE, no loaded results.
 - ``"hybrid"`` (the default of every gear case) and ``"hertz"``: as ``"fe"`` with the compliance
-  of :mod:`fegear.ltca.hybrid` or the per-pair Hertz laws of :mod:`fegear.ltca.hertz_model`.
+  of :mod:`fegear.ltca.hybrid` or the per-pair Hertz laws of :mod:`fegear.ltca.hertz_fidelity`.
 
 Before any FE work, :func:`fegear.pipeline.engagement.check_engagement` decides every way the
 contact can fail. What the run reports (the headlines over the usable positions, the warnings)
@@ -31,17 +31,22 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from fegear.assembly import Assembly
 from fegear.errors import InputError
+from fegear.geometry.pair_placement import Assembly
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase
+from fegear.ltca import LTCAOptions, build_models, run_ltca
+from fegear.ltca.cycle import cycle_tca
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.results import LoadedCycle
 from fegear.pipeline.engagement import Engagement, check_clearance, check_engagement
 from fegear.pipeline.fields import MemberField, displacements
 from fegear.pipeline.pair import GearPair, build_pair
-from fegear.store.cache import CacheUse
-from fegear.tca.ellipse import EllipseAt
-from fegear.tca.results import CycleResult
+from fegear.store.cache import CacheUse, record_cache_use
+from fegear.tca import TCAOptions
+from fegear.tca.cached import cached_tca
+from fegear.tca.cycle import cycle_result
+from fegear.tca.ellipse import EllipseAt, ellipses
+from fegear.tca.results import ARCSEC, CycleResult
 
 __all__ = ["GearRun", "run_gear_case"]
 
@@ -105,8 +110,6 @@ class GearRun:
     @property
     def phi2(self) -> Array:
         """``(n,)`` rad, gear angle of the TCA-closed position (``ratio φ1 + TE_unloaded``)."""
-        from fegear.tca.results import ARCSEC
-
         c = self.cycle if self.cycle is not None else self.tca
         te = c.te_unloaded_arcsec if self.cycle is not None else c.te_arcsec
         return self.assembly.ratio * np.asarray(c.phi1) + np.asarray(te) * ARCSEC
@@ -165,8 +168,6 @@ def run_gear_case(
     """
     from dataclasses import replace
 
-    from fegear.store.cache import record_cache_use
-
     with record_cache_use() as used:
         run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify)
     return replace(run, cache=used())
@@ -174,19 +175,11 @@ def run_gear_case(
 
 def _ellipses(case: GearCase, tca, positions) -> tuple:
     """The contact ellipses of the TCA positions at the case's load (:mod:`fegear.tca.ellipse`)."""
-    from fegear.tca.ellipse import ellipses
-
     T1 = case.pinion_torque_Nm
     return ellipses(positions, tca.asm.axis1(), T1, tca.opt.paint_mm, case.E_MPa, case.nu)
 
 
 def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> GearRun:
-    from fegear.ltca import LTCAOptions, build_models, run_ltca
-    from fegear.ltca.cycle import cycle_tca
-    from fegear.tca import TCAOptions
-    from fegear.tca.cached import cached_tca
-    from fegear.tca.cycle import cycle_result
-
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
     seconds: dict[str, float] = {}

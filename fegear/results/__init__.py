@@ -5,9 +5,19 @@
 Python API (:class:`fegear.api.GearResult`) read it; :func:`load_result` reads a saved
 ``summary.json`` back into the same model. The classes (:mod:`fegear.results.model`) are frozen
 dataclasses with the units in the field names.
+
+The Hertz scene's run has its own model, :mod:`fegear.results.hertz_scene`
+(:class:`HertzSceneResult`: built by :func:`build_hertz_result`, written as ``summary.json`` by
+:func:`hertz_summary_document`, read back by :func:`load_hertz_result`).
 """
 
 from fegear.results.build import build_result
+from fegear.results.hertz_scene import (
+    HertzSceneResult,
+    build_hertz_result,
+    hertz_summary_document,
+    load_hertz_result,
+)
 from fegear.results.model import (
     Checks,
     Cycle,
@@ -24,10 +34,14 @@ __all__ = [
     "Cycle",
     "Excluded",
     "GearRunResult",
+    "HertzSceneResult",
     "PairLoad",
     "PatternCentre",
     "Position",
+    "build_hertz_result",
     "build_result",
+    "hertz_summary_document",
+    "load_hertz_result",
     "load_result",
     "result_from_summary",
     "summary_document",

@@ -29,6 +29,8 @@ from fegear.results.model import (
     Position,
 )
 from fegear.results.records import solver_record, versions
+from fegear.tca import TCAOptions
+from fegear.tca.ellipse import cycle_record, record
 from fegear.units import ARCSEC_PER_RAD, nm_from_nmm
 
 __all__ = ["build_result"]
@@ -225,8 +227,6 @@ def _member_stress_row(mf, i: int) -> dict[str, Any]:
 
 
 def _ellipse_row(run: GearRun, i: int) -> dict[str, Any] | None:
-    from fegear.tca.ellipse import record
-
     return record(run.ellipses[i]) if i < len(run.ellipses) else None
 
 
@@ -366,9 +366,6 @@ def _root_stress(run: GearRun) -> dict[str, Any]:
 
 
 def _ellipse_cycle(run: GearRun) -> dict[str, Any]:
-    from fegear.tca import TCAOptions
-    from fegear.tca.ellipse import cycle_record
-
     delta = next((e.delta_mm for e in run.ellipses if e is not None), TCAOptions().paint_mm)
     doc = cycle_record(run.ellipses, delta, run.case.pinion_torque_Nm)
     if not run.ellipses:

@@ -83,8 +83,8 @@ class PairLoad:
     pressure_reason
         Why a loaded pair has no pressure ("" when it has one): ``hertz`` at a flank edge.
     p_peak_MPa
-        Recovered peak pressure of the patch (MPa; :func:`fegear.patch.measure_patch`); None at
-        fidelity ``tca`` and where the fidelity gives no pressure.
+        Recovered peak pressure of the patch (MPa; :func:`fegear.mechanics.patch.measure_patch`);
+        None at fidelity ``tca`` and where the fidelity gives no pressure.
     n_active_cells
         Contact cells in contact; None at fidelity ``tca``.
     cells_across_patch

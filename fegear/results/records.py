@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.metadata
 import platform
 
-from fegear.contact import ContactSolution
+from fegear.mechanics.contact import ContactSolution
 
 __all__ = ["solver_record", "versions"]
 

@@ -41,7 +41,7 @@ UNITS = {
 
 CONVENTIONS = {
     "te": "TE = (phi2 - phi2_0) - (N1/N2)(phi1 - phi1_0) on member 2; negative: lag",
-    "frame": "fixed frame of fegear.assembly (contact points, VTK)",
+    "frame": "fixed frame of fegear.geometry.pair_placement (contact points, VTK)",
     "speed": "quasi-static model: speed does not enter",
 }
 

@@ -1,10 +1,10 @@
 """The Hertz scene: a crowned roller pressed on a block, solved with the FE contact engine.
 
 This is the scene whose answer is known. The same pieces the gear analysis uses run here
-unchanged: gmsh meshes (:mod:`fegear.mesh.hertz_bodies`), scikit-fem stiffness
+unchanged: gmsh meshes (:mod:`fegear.mesh.hertz_scene_bodies`), scikit-fem stiffness
 (:mod:`fegear.fem`), the Schur-complement compliance on a contact grid (:mod:`fegear.compliance`)
-and the active-set solver (:mod:`fegear.contact`); the closed-form Hertz solution
-(:mod:`fegear.hertz`) is the reference.
+and the active-set solver (:mod:`fegear.mechanics.contact`); the closed-form Hertz solution
+(:mod:`fegear.mechanics.hertz_closed_form`) is the reference.
 
 Contact grid: square cells of side ``s`` in the common tangent plane ``z = 0`` covering the
 rectangle ``|x| <= X, |y| <= Y`` (its quarter with symmetry), ``X, Y`` = ``margin`` × the Hertz
@@ -41,14 +41,19 @@ from fegear.compliance import (
     load_operator,
     probe_operator,
 )
-from fegear.contact import ContactSolution, solve_contact
 from fegear.errors import InputError
 from fegear.fem.elasticity import ElasticBody, assemble_body
-from fegear.halfspace import subsurface_influence
-from fegear.hertz import HertzPoint, hertz_point_radii
 from fegear.linalg.solve import factorize_spd
-from fegear.mesh.hertz_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh, roller_height
-from fegear.patch import measure_patch
+from fegear.mechanics.contact import ContactSolution, solve_contact
+from fegear.mechanics.halfspace import subsurface_influence
+from fegear.mechanics.hertz_closed_form import HertzPoint, hertz_point_radii
+from fegear.mechanics.patch import measure_patch
+from fegear.mesh.hertz_scene_bodies import (
+    BodyMeshSpec,
+    cached_body_mesh,
+    read_tet_mesh,
+    roller_height,
+)
 
 __all__ = [
     "CELLS_ACROSS_MINOR",

@@ -61,7 +61,7 @@ import numpy as np
 
 from fegear.errors import InputError
 from fegear.store.checksum import file_checksum
-from fegear.store.files import atomic_write
+from fegear.store.files import atomic_write, check_writable_folder
 from fegear.store.limit import ENV_LIMIT, cache_limit, evict, stored_entries
 
 __all__ = [
@@ -249,9 +249,10 @@ def _code_hash(modules: tuple[str, ...]) -> str:
 
 def code_hash(*modules: str) -> str:
     """SHA-256 (hex, 20 characters) of the source files of the fegear packages and modules
-    ``modules`` (``"fegear.mesh"``: every ``.py`` below ``fegear/mesh``; ``"fegear.hertz"``:
-    ``fegear/hertz.py``), read once per process. The code version of an artefact: any change of
-    the code that produces it changes its key."""
+    ``modules`` (``"fegear.mesh"``: every ``.py`` below ``fegear/mesh``;
+    ``"fegear.mechanics.hertz_closed_form"``:
+    ``fegear/mechanics/hertz_closed_form.py``), read once per process. The code version of an
+    artefact: any change of the code that produces it changes its key."""
     return _code_hash(tuple(sorted(set(modules))))
 
 
@@ -289,13 +290,14 @@ class Producer:
 _MESH_CODE = ("fegear.mesh", "fegear.geometry")
 _MESH_DEPS = ("gmsh", "meshio", "numpy", "scipy")
 _FE_DEPS = (*_MESH_DEPS, "scikit-fem")
-_TCA_CODE = ("fegear.tca", "fegear.geometry", "fegear.assembly", "fegear.hertz")
+_TCA_CODE = ("fegear.tca", "fegear.geometry", "fegear.mechanics.hertz_closed_form")
 _TCA = Producer(_TCA_CODE, ("numpy", "scipy"))
 
 #: The producer of every kind of artefact (a kind not listed here cannot be cached).
 PRODUCERS: Mapping[str, Producer] = MappingProxyType(
     {
-        # sector meshes (fegear.mesh.sector) and the Hertz scene's bodies (fegear.mesh.hertz_bodies)
+        # sector meshes (fegear.mesh.sector) and the Hertz scene's bodies
+        # (fegear.mesh.hertz_scene_bodies)
         "mesh": Producer(_MESH_CODE, _MESH_DEPS),
         # the flank operators (fegear.compliance.candidate_operator) of a meshed body
         "compliance": Producer(
@@ -806,8 +808,6 @@ def check_cache_root() -> Path:
     InputError
         The root is unusable (the CLI's exit code 2).
     """
-    from fegear.store.files import check_writable_folder
-
     root = cache_root()
     field = "FEGEAR_CACHE" if os.environ.get("FEGEAR_CACHE", "").strip() else "cache folder"
     check_writable_folder(root, field)

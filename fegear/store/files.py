@@ -19,6 +19,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from fegear.errors import InputError
+
 __all__ = [
     "STALE_AGE_S",
     "TEMP_PATTERN",
@@ -162,8 +164,6 @@ def check_writable_folder(path: str | Path, field: str = "--out") -> Path:
     be created (:class:`~fegear.errors.InputError` naming ``field``). Nothing is created; a
     probe file is made and removed in the nearest existing folder (``os.access`` is not enough:
     it says yes to root on a read-only file system)."""
-    from fegear.errors import InputError
-
     p = Path(path)
     if p.exists() and not p.is_dir():
         raise InputError(field, str(p), "a folder (it is an existing file)")

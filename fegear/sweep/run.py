@@ -10,7 +10,7 @@ writes the sweep outputs (:mod:`fegear.sweep.output`: ``sweep.json``, ``comparis
 Grid specification (``KEY=START:STOP:N`` or ``KEY=V1,V2,...``): ``KEY`` is a case-file key
 ``section.key`` (``errors.dgamma_deg``, ``load.torque2_Nm``, ``pair.module_mm``, ...). Every grid
 point is written into a copy of the base case's TOML document and validated by the case-file
-parser (:func:`fegear.case.parse_case`), so a bad key or value is refused exactly as in a case
+parser (:func:`fegear.case_files.parse_case`), so a bad key or value is refused exactly as in a case
 file, before any work. A load key replaces the case's torque key (a case has exactly one).
 Several grid axes make their Cartesian product.
 
@@ -56,8 +56,14 @@ from pathlib import Path
 from typing import Any
 
 from fegear import __version__
+from fegear.case_files import load_case, parse_case
 from fegear.errors import BackendUnavailable, FegearError, InputError
 from fegear.io.gear_case import FIDELITIES, GEAR_KINDS, N_LEVELS, GearCase
+from fegear.output.gear_output import write_gear_outputs
+from fegear.pipeline.run import run_gear_case
+from fegear.store.cache import cache_root as _cache_root
+from fegear.store.cache import content_hash
+from fegear.store.files import write_json
 from fegear.sweep.marker import MARKER, digest, read_marker, verified_summary
 from fegear.sweep.output import comparison_error, write_sweep_json, write_sweep_outputs
 from fegear.units import TORQUE_KEYS
@@ -140,8 +146,6 @@ class SweepItem:
 
     def fingerprint(self) -> str:
         """Hash of everything the item's results depend on (the file it came from excluded)."""
-        from fegear.store.cache import content_hash
-
         inputs = self.case.to_dict()
         inputs.pop("source", None)
         return content_hash({"inputs": inputs, "fegear": __version__})
@@ -280,8 +284,6 @@ def parse_grid(spec: str) -> GridAxis:
 
 def _read_toml(path: Path) -> dict[str, Any]:
     """The raw TOML document of a case file (the errors are those of :func:`load_case`)."""
-    from fegear.case import load_case
-
     load_case(path)  # every problem of the file itself: one InputError, as for `fegear run`
     return tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
 
@@ -356,8 +358,6 @@ def build_items(
         A bad case file, grid specification, key or value (named as in the case file, with the
         grid specification it came from), duplicate item names, or bad overrides.
     """
-    from fegear.case import parse_case
-
     _check_overrides(fidelity, level)
     if not cases:
         raise InputError("CASE", "none", "at least one case file")
@@ -476,10 +476,6 @@ def run_item(
         each item by the sweep's own workers (1 on a Dask cluster; None: ``$FEGEAR_WORKERS``
         or one per core).
     """
-    from fegear.output.gear_output import write_gear_outputs
-    from fegear.pipeline.run import run_gear_case
-    from fegear.store.files import write_json
-
     out = Path(out)
     final = out / item.name
     if is_done(final, item):
@@ -639,7 +635,6 @@ def run_sweep(
         raise InputError("--nominal", nominal, f"one of the item names {names}")
     out = Path(out).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    from fegear.store.cache import cache_root as _cache_root
 
     # the workers (local processes or Dask) must use this process's cache, wherever they run
     cache_root = str(_cache_root().resolve())

@@ -1,6 +1,6 @@
 """Unloaded tooth contact analysis (TCA) over the mesh cycle, multi-pair (``docs/tca/README.md``).
 
-Use :func:`run_tca` on an :class:`~fegear.assembly.Assembly`; results are
+Use :func:`run_tca` on an :class:`~fegear.geometry.pair_placement.Assembly`; results are
 :class:`CycleResult` / :class:`PositionResult`; :class:`SeparationGrid` is the contact grid of
 the loaded analysis.
 """

@@ -16,8 +16,8 @@ terms of bevel practice:
   by ``θ h`` with ``h = (σ e2 × M) · n`` (gear rotation axis ``−σ e2`` in its driving sense), so
   ``ΔTE = −θ = −(δr · n)/h`` at ``φ1 = 0`` to first order, whatever the contact point shift
   (the gap is stationary at the contact point). With the conventions of
-  :mod:`fegear.assembly`: ``δr = ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the gear moves),
-  ``(−Δγ e_y) × M`` (Δγ, pinion axis turned about ``e_y`` through the apex by ``−Δγ``).
+  :mod:`fegear.geometry.pair_placement`: ``δr = ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the
+  gear moves), ``(−Δγ e_y) × M`` (Δγ, pinion axis turned about ``e_y`` through the apex by ``−Δγ``).
 """
 
 from __future__ import annotations
@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..assembly import InstallationErrors, spiral_bevel_assembly
+from ..geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
+from ..geometry.transforms import apply_points, inverse
 from .core import TCAOptions
 from .cycle import run_tca
 from .results import ARCSEC, CycleResult
@@ -197,8 +198,6 @@ def path_angle_on_gear(pair, side: str = "drive", dphi: float = 0.02) -> tuple[f
     (η is measured from the tooth trace toward the tip, :class:`SynthesisTargets`; the path is a
     line, so the difference is taken modulo 180°).
     """
-    from ..geometry.transforms import apply_points, inverse
-
     asm = spiral_bevel_assembly(pair, side)
     opt = TCAOptions(separation_grid=None, pair_offsets=(0,))
     r = run_tca(pair.pinion, pair.gear, asm, opt, phi1=np.array([-dphi, dphi]))

@@ -9,7 +9,8 @@ torque, another fidelity or mesh level, a re-run) reads it back instead of solvi
 The key (:func:`fegear.store.cache.artefact_key`) holds the members' ``repr`` (their complete
 design data, as for the sector meshes), the assembly's fields, the options and the angles, with
 the code version of the TCA's producer (the source of ``fegear.tca``, ``fegear.geometry``,
-``fegear.assembly`` and ``fegear.hertz``) and the numpy and scipy versions
+``fegear.geometry.pair_placement`` and ``fegear.mechanics.hertz_closed_form``) and the numpy and
+scipy versions
 (:data:`fegear.store.cache.PRODUCERS`), so a change of the code that produces the positions
 invalidates the entry by itself.
 
@@ -29,7 +30,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..assembly import Assembly
+from fegear.store.cache import cached_record
+
+from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
 from .results import PositionResult, from_record, to_record
@@ -105,8 +108,6 @@ def cached_phase(pinion, gear, assembly: Assembly, options: TCAOptions) -> float
     face gear the phasing is about 60 % of a new error's TCA)."""
     from dataclasses import replace
 
-    from fegear.store.cache import cached_record
-
     nominal = assembly.without_errors()
     opt = replace(options, separation_grid=None, pinion_torque_Nm=None)
     params = pair_key(pinion, gear, nominal, opt)
@@ -127,8 +128,6 @@ def cached_tca(
     Returns the :class:`~fegear.tca.TCA` of the phased assembly (the loaded analysis evaluates
     its flank maps) and the positions.
     """
-    from fegear.store.cache import cached_record
-
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, object] = {}

@@ -1,6 +1,7 @@
 r"""Contact lines of a cylindrical (spur or helical) pair and its contact ratios.
 
-Parallel axes, external pair, error-free assembly (:func:`fegear.assembly.involute_assembly`):
+Parallel axes, external pair, error-free assembly
+(:func:`fegear.geometry.pair_placement.involute_assembly`):
 pinion axis ``+z`` through the origin, gear axis through ``(a, 0, 0)``. The unmodified flanks
 (involute helicoids, :mod:`fegear.geometry.cylindrical`) touch along straight lines in the
 *plane of action*, the plane tangent to both base cylinders,

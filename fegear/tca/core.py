@@ -8,7 +8,7 @@ are searched against the pinion surface as well (edge contact of the gear), so t
 flank boundary is found. The pair's closing rotation is the smaller of the two; the unloaded TE is
 ``−min over pairs`` (``docs/conventions.md``: ``Δφ2 = φ2 − (N1/N2) φ1``, negative = the gear lags).
 Then the separation field along the pinion normal (the LTCA contact grid), the contact ellipse
-(paint thickness and Hertz, :mod:`fegear.hertz`) and the edge flags follow.
+(paint thickness and Hertz, :mod:`fegear.mechanics.hertz_closed_form`) and the edge flags follow.
 
 Pairs: ``m ∈ pair_offsets`` gives pinion tooth ``k = −s1 m`` and gear tooth ``j = −s2 m``
 (``s_i`` the driving senses), so ``m = 0`` is in contact at ``φ1 = 0`` and ``m = +1`` is the next
@@ -26,10 +26,10 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline, LinearNDInterpolator
 from scipy.spatial import cKDTree
 
-from ..assembly import Assembly, tooth_transform
 from ..errors import InputError
+from ..geometry.pair_placement import Assembly, tooth_transform
 from ..geometry.transforms import apply_points, apply_vectors, compose, inverse
-from ..hertz import effective_modulus, hertz_point, paint_ellipse
+from ..mechanics.hertz_closed_form import effective_modulus, hertz_point, paint_ellipse
 from .ellipse import contact_curvature, normal_force
 from .results import ContactEllipseAt, PositionResult, SeparationGrid
 from .solve import circle_hit, in_bounds, line_hit, wrap
@@ -141,7 +141,8 @@ class TCA:
     pinion, gear
         :class:`~fegear.geometry.surface.GeneratedMember` of member 1 and 2.
     assembly
-        Placement (:mod:`fegear.assembly`); its ``side1``/``side2`` select the flanks.
+        Placement (:mod:`fegear.geometry.pair_placement`); its ``side1``/``side2`` select the
+        flanks.
     options
         :class:`TCAOptions`.
     maps

@@ -7,7 +7,7 @@ import logging
 import numpy as np
 from numpy.typing import NDArray
 
-from ..assembly import Assembly
+from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .results import ARCSEC, CycleResult, PositionResult
 

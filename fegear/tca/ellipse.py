@@ -7,7 +7,7 @@ the exact surfaces (:func:`contact_curvature`); this module turns them into what
 - the **principal relative curvatures** ``k_a <= k_b`` (1/mm) and their directions,
 - Litvin's **instantaneous contact ellipse** for an elastic approach ``δ`` (the paint thickness),
 - the **Hertz ellipse** (a, b, p0) of one pair carrying the whole load
-  (:func:`fegear.hertz.hertz_point`).
+  (:func:`fegear.mechanics.hertz_closed_form.hertz_point`).
 
 Geometry (Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed. 2004, the chapter
 "Mating Surfaces: Curvature Relations, Contact Ellipse"). At the contact point ``M`` both flanks
@@ -24,7 +24,8 @@ curvature tensor with its *own* outward normal (convex positive; the gear's outw
 in the principal axes of the relative curvature tensor ``K_1 + K_2``, whose eigenvalues
 ``k_a <= k_b`` are Litvin's principal (induced normal) relative curvatures. (Litvin measures the
 second surface's curvatures with the first surface's normal, so his ``k = κ^{(1)} − κ^{(2)}`` is
-this sum; Johnson's ``h = A ξ² + B η²`` of :mod:`fegear.hertz` has ``A = k_a/2``, ``B = k_b/2``.)
+this sum; Johnson's ``h = A ξ² + B η²`` of :mod:`fegear.mechanics.hertz_closed_form` has ``A =
+k_a/2``, ``B = k_b/2``.)
 
 Instantaneous contact ellipse: the flanks pressed together by an approach ``δ`` overlap where
 ``h <= δ``; its boundary ``h = δ`` is the ellipse
@@ -35,11 +36,13 @@ Instantaneous contact ellipse: the flanks pressed together by an approach ``δ``
     a = \sqrt{2\delta / k_a} = \sqrt{\delta / A}, \qquad
     b = \sqrt{2\delta / k_b} = \sqrt{\delta / B},
 
-Litvin's ``a = |2δ/k_a|^{1/2}``, ``b = |2δ/k_b|^{1/2}`` (:func:`fegear.hertz.paint_ellipse`).
+Litvin's ``a = |2δ/k_a|^{1/2}``, ``b = |2δ/k_b|^{1/2}``
+(:func:`fegear.mechanics.hertz_closed_form.paint_ellipse`).
 The major axis lies along ``ξ``, the direction of the smaller curvature; the axis ratio
 ``a/b = sqrt(k_b/k_a)`` does not depend on ``δ``. ``δ`` is a chosen constant (customarily the
 paint thickness 0.00632 mm), not the elastic approach of a load: the Hertz ellipse of a load is
-smaller and more elongated (:func:`fegear.hertz.hertz_point`; Johnson 1985 §4.2).
+smaller and more elongated (:func:`fegear.mechanics.hertz_closed_form.hertz_point`; Johnson 1985
+§4.2).
 
 Hertz at the case's load: the pinion torque ``T1`` carried by this one pair, normal force
 ``F = T1 / |(e_1 × (M − O_1)) · n|`` (``O_1``, ``e_1`` a point on and the direction of the
@@ -61,7 +64,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..geometry.surface import finite_difference_curvatures
 from ..geometry.transforms import apply_vectors
-from ..hertz import HertzPoint, effective_modulus, hertz_point, paint_ellipse
+from ..mechanics.hertz_closed_form import HertzPoint, effective_modulus, hertz_point, paint_ellipse
 from ..units import NMM_PER_NM
 
 __all__ = [
@@ -241,7 +244,8 @@ class EllipseAt:
     pinion_torque_Nm, force_N
         The load and the normal force of one pair carrying it (0 without a load).
     hertz
-        :class:`~fegear.hertz.HertzPoint` of ``force_N``, or None (``hertz_reason``).
+        :class:`~fegear.mechanics.hertz_closed_form.HertzPoint` of ``force_N``, or None
+        (``hertz_reason``).
     major_to_face_deg
         ``{"pinion": deg, "gear": deg}``: angle of the major axis from each flank's face
         direction (``∂X/∂v`` in the tangent plane) toward its tip (``∂X/∂u``), in (−90, 90].
@@ -366,7 +370,7 @@ def ellipses(
     positions
         :class:`~fegear.tca.results.PositionResult` sequence (their ``ellipse.curvature``).
     axis1
-        ``(O_1, e_1)`` of the pinion axis (:meth:`fegear.assembly.Assembly.axis1`).
+        ``(O_1, e_1)`` of the pinion axis (:meth:`fegear.geometry.pair_placement.Assembly.axis1`).
     pinion_torque_Nm
         The load of the Hertz ellipses (one pair carrying it), or None.
     delta_mm

@@ -30,7 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.store.cache import cached_file
+
 from ..geometry.transforms import apply_points, compose, inverse
+from .cached import pair_key
 
 __all__ = [
     "Clearance",
@@ -364,10 +367,6 @@ def cached_handover(pinion, gear, assembly, options, tca, n_samples: int = 48) -
     assembly with its errors, TCA options: the ``tca`` is the one they give) was checked before
     (FZG 0.3-1.5 s, seed face gear ~1 s, spiral bevel ~2 s otherwise)."""
     import json
-
-    from fegear.store.cache import cached_file
-
-    from .cached import pair_key
 
     params = {**pair_key(pinion, gear, assembly, options), "n_samples": n_samples}
     box: dict[str, Handover] = {}

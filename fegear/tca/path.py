@@ -29,7 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from fegear.store.cache import cached_file
+
 from ..geometry.transforms import apply_points
+from .cached import pair_key
 from .core import TCA
 from .results import PositionResult
 
@@ -220,10 +223,6 @@ def cached_contact_path(pinion, gear, assembly, options, tca: TCA, positions) ->
     """:func:`contact_path` of the pair, read from the artefact cache when the same pair
     (members, assembly with its errors, TCA options, the positions' angles) was traced before
     (seed face gear ~1.8 s otherwise)."""
-    from fegear.store.cache import cached_file
-
-    from .cached import pair_key
-
     phi1 = np.array([p.phi1 for p in positions], dtype=float)
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, ContactPath | None] = {}

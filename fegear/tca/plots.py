@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .ellipse import outline
 from .results import CycleResult
 
 __all__ = [
@@ -145,8 +146,6 @@ def draw_ellipses(
     (x (n,), y (n,))`` the plot coordinates of flank coordinates (default ``(v, u)``). Returns the
     number of outlines drawn (line contacts have none).
     """
-    from .ellipse import outline
-
     xy = xy or (lambda uv: (uv[:, 1], uv[:, 0]))
     styles = {"paint": "-", "hertz": "--"}
     n = 0
@@ -199,7 +198,7 @@ def plot_pattern(
 
 
 def plot_assembly_conventions(path: str | Path) -> Path:
-    """The sign conventions of :mod:`fegear.assembly` in two schematic panels."""
+    """The sign conventions of :mod:`fegear.geometry.pair_placement` in two schematic panels."""
     plt = _plt()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.5))
     # intersecting axes (face-gear frame: gear axis z, pinion axis x at height r_p1)

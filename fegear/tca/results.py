@@ -1,7 +1,8 @@
 """Typed TCA results (frozen dataclasses; arrays with shapes and units documented).
 
 Sign conventions: ``docs/conventions.md``. ``θ`` is a rotation of member 2 AGAINST its driving sense
-(a lag, rad) — the unknown of :mod:`fegear.contact` — and the unloaded TE is ``−θ*`` with ``θ*`` the
+(a lag, rad) — the unknown of :mod:`fegear.mechanics.contact` — and the unloaded TE is ``−θ*`` with
+``θ*`` the
 rotation that closes the smallest gap over all pairs, relative to the reference position (the
 error-free pair in contact at ``φ1 = 0``). No array holds NaN: entries without meaning are 0 and
 masked by a boolean array next to them.
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..hertz import HertzPoint
+from ..mechanics.hertz_closed_form import HertzPoint
 from .ellipse import ContactCurvature
 
 __all__ = [
@@ -41,7 +42,7 @@ class SeparationGrid:
     Cells are centred on a regular grid of the pinion flank coordinates; after the rigid closing
     rotation ``θ*`` of member 2, the gap of cell ``i`` after a further lag ``θ`` of member 2 is
     ``separation_i − θ h_i`` to first order (the form ``d = g − θ h + C F`` of
-    :func:`fegear.contact.solve_contact`).
+    :func:`fegear.mechanics.contact.solve_contact`).
 
     Attributes
     ----------
@@ -81,7 +82,8 @@ class SeparationGrid:
 
     def contact_cells(self) -> tuple[Array, Array, Array, Array, Array]:
         """Valid cells flattened: ``points (m, 3)``, ``normals (m, 3)``, ``g (m,)``, ``h (m,)``,
-        ``area (m,)`` — ready for :func:`fegear.contact.solve_contact` (``weights = h``)."""
+        ``area (m,)`` — ready for :func:`fegear.mechanics.contact.solve_contact`
+        (``weights = h``)."""
         m = self.valid
         return self.points[m], self.normals[m], self.separation[m], self.h[m], self.area[m]
 
@@ -97,9 +99,11 @@ class ContactEllipseAt:
     major_axis
         ``(3,)`` unit direction of the major axis (fixed frame).
     paint_a_mm, paint_b_mm
-        Litvin's instantaneous ellipse for the paint thickness (:func:`fegear.hertz.paint_ellipse`).
+        Litvin's instantaneous ellipse for the paint thickness
+        (:func:`fegear.mechanics.hertz_closed_form.paint_ellipse`).
     hertz
-        Elastic Hertz contact for the given load (:func:`fegear.hertz.hertz_point`) or None.
+        Elastic Hertz contact for the given load
+        (:func:`fegear.mechanics.hertz_closed_form.hertz_point`) or None.
     force_N
         Normal force used for ``hertz`` (pinion torque / moment arm of the normal), 0 if none.
     line_contact
@@ -270,7 +274,7 @@ def to_record(obj: object, arrays: dict[str, np.ndarray], key: str) -> object:
     reads back exactly), ``str``; numpy arrays of numbers or booleans and numpy scalars (stored
     in ``arrays`` under names starting with ``key``, dtype and shape kept); tuples and lists;
     dicts with ``str`` keys; the result dataclasses of this module and
-    :class:`~fegear.hertz.HertzPoint`.
+    :class:`~fegear.mechanics.hertz_closed_form.HertzPoint`.
 
     Raises
     ------

@@ -23,6 +23,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from fegear.errors import InputError
+
 __all__ = ["Row", "Value", "as_row"]
 
 
@@ -121,8 +123,6 @@ def as_row(r: Row | Mapping[str, Any]) -> Row:
     InputError
         A mapping without the fields of a row.
     """
-    from fegear.errors import InputError
-
     if isinstance(r, Row):
         return r
     if not isinstance(r, Mapping):

@@ -49,8 +49,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fegear.api import run
+from fegear.io.gear_case import parse_gear_case
+from fegear.ltca import LTCAOptions, run_ltca
+from fegear.ltca.line_load import load_distribution
+from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_line
+from fegear.pipeline.pair import build_pair
+from fegear.tca.contact_lines import (
+    contact_ratios,
+    iso_contact_ratios,
+    plane_of_action,
+    section_contact,
+)
 from fegear.validation import Row, Value
 from fegear.validation.iso6336 import single_stiffness, theoretical_single_stiffness
+from fegear.validation.iso6336_root import nominal_root_stress, root_factors
 
 __all__ = [
     "PAIRS",
@@ -91,8 +104,6 @@ PAIRS = {
 
 def pair_case(name: str, n_positions: int = 12, **errors: float):
     """The :class:`~fegear.io.gear_case.GearCase` of :data:`PAIRS` ``[name]`` (hybrid level 0)."""
-    from fegear.io.gear_case import parse_gear_case
-
     pair, torque, _ = PAIRS[name]
     case = parse_gear_case(
         {
@@ -106,8 +117,6 @@ def pair_case(name: str, n_positions: int = 12, **errors: float):
 
 
 def _members(case):
-    from fegear.pipeline.pair import build_pair
-
     p = build_pair(case)
     return p.pinion, p.gear, p.assembly
 
@@ -115,8 +124,6 @@ def _members(case):
 # --------------------------------------------------------------------------- contact ratios
 def contact_ratio_rows(names=("fzg_type_c", "helical_15", "helical_25")) -> list[Row]:
     """εα, εβ, εγ measured on the flanks against ISO 21771's closed forms (no solver)."""
-    from fegear.tca.contact_lines import contact_ratios, iso_contact_ratios
-
     rows = []
     for name in names:
         t0 = time.perf_counter()
@@ -163,10 +170,6 @@ class StiffnessRun:
 
 def stiffness_run(name: str, n_positions: int = 12) -> StiffnessRun:
     """Run :data:`PAIRS` ``[name]`` at ``hybrid`` level 0 over a cycle (module docstring)."""
-    from fegear.api import run
-    from fegear.ltca.line_load import load_distribution
-    from fegear.tca.contact_lines import iso_contact_ratios
-
     t0 = time.perf_counter()
     case = pair_case(name, n_positions)
     r = run(case)
@@ -251,8 +254,6 @@ class HertzRun:
 def _pitch_phi1(p, g, asm) -> float:
     """The pinion angle at which pair 0's contact in the middle section of the face is at the
     pitch point: its roll length on the pinion is ``r_b1 tan α_wt`` (linear in the angle)."""
-    from fegear.tca.contact_lines import plane_of_action, section_contact
-
     pa = plane_of_action(p, g, asm)
     zm = 0.5 * sum(pa.face)
     target = p.r_b * math.tan(pa.alpha_wt)
@@ -268,11 +269,6 @@ def _pitch_phi1(p, g, asm) -> float:
 def helical_hertz_run(name: str = "helical_15", level: int = 0) -> HertzRun:
     """The loaded pair at the pitch point (one position, ``hybrid``; module docstring)."""
     from dataclasses import replace as _replace
-
-    from fegear.hertz import effective_modulus, hertz_line
-    from fegear.ltca import LTCAOptions, run_ltca
-    from fegear.ltca.line_load import load_distribution
-    from fegear.tca.contact_lines import plane_of_action
 
     t0 = time.perf_counter()
     case = pair_case(name)
@@ -351,10 +347,6 @@ def _iso_khb(c_gb: float, f_by_um: float, fm_b: float) -> float:
 
 def khb_run(name: str = "helical_15", f_beta_x_um: float = 15.0, n_positions: int = 12):
     """The pair with and without the axis deviation of ``F_βx`` (µm) along the line of action."""
-    from fegear.api import run
-    from fegear.ltca.line_load import load_distribution
-    from fegear.tca.contact_lines import iso_contact_ratios, plane_of_action
-
     t0 = time.perf_counter()
     case = pair_case(name, n_positions)
     p, g, asm = _members(case)
@@ -441,9 +433,6 @@ def iso_root_stress(name: str) -> tuple[dict, dict, float, float]:
     :func:`fegear.validation.iso6336_root.root_factors`), ``Y_β = 1 − ε_β β/120°`` (``ε_β``,
     ``β`` capped at 1 and 30°) and ``F_t = 2 T/d`` at the reference circle:
     ``σ_{F0} = F_t/(b m_n) Y_F Y_S Y_β``. Returns ``(σF0, (z_n, Y_F, Y_S), Y_β, ε_β)``."""
-    from fegear.tca.contact_lines import iso_contact_ratios
-    from fegear.validation.iso6336_root import nominal_root_stress, root_factors
-
     case = pair_case(name)
     p, g, asm = _members(case)
     ea, eb, _ = iso_contact_ratios(p, g, asm)
@@ -473,8 +462,6 @@ def root_run(name: str = "helical_15", n_positions: int = 16) -> RootRun:
     FE value is the largest over the positions and the loaded teeth: ISO's σF0 is the nominal
     stress of the most unfavourable load position, which a helical tooth meets somewhere in the
     cycle; ``n_positions`` samples it."""
-    from fegear.api import run
-
     t0 = time.perf_counter()
     r = run(pair_case(name, n_positions).replace(root_stress=True))
     dt = time.perf_counter() - t0

@@ -27,7 +27,8 @@ length :math:`w = F_{bn}/b` carry the peak pressure
 .. math:: p_H = \sqrt{\frac{w E^*}{\pi R}}, \qquad \frac1R = \frac1{\rho_{C1}} + \frac1{\rho_{C2}},
           \qquad \frac1{E^*} = \frac{1-\nu_1^2}{E_1} + \frac{1-\nu_2^2}{E_2},
 
-(:func:`fegear.hertz.hertz_line`). For a spur pair whose gear carries the torque :math:`T_2`
+(:func:`fegear.mechanics.hertz_closed_form.hertz_line`). For a spur pair whose gear carries the
+torque :math:`T_2`
 alone (single-pair zone) the normal load is :math:`F_{bn} = T_2 / r_{b2}` along the line of
 action. ISO 6336-2 writes the same number as the nominal contact stress
 
@@ -73,7 +74,7 @@ import math
 from dataclasses import dataclass
 
 from fegear.errors import InputError
-from fegear.hertz import effective_modulus, hertz_line
+from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_line
 
 __all__ = [
     "CTH_COEFFICIENTS",

@@ -75,7 +75,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fegear.api import load_case
 from fegear.errors import FegearError, InputError
+from fegear.geometry.transforms import apply_points, inverse
+from fegear.ltca import LTCAOptions, build_models, run_ltca
+from fegear.pipeline.fields import displacements
+from fegear.pipeline.pair import build_pair
+from fegear.tca import TCA, TCAOptions, reference_phase
+from fegear.tca.results import ARCSEC
+from fegear.validation import Row, Value
+from fegear.validation.rows import pitch_point_phi1
 
 __all__ = [
     "CriticalSection",
@@ -301,8 +310,6 @@ def _design(member):
 def fzg_reference(case=None) -> dict[str, tuple[RootFactors, float]]:
     """``{"pinion": (factors, σF0), "gear": (factors, σF0)}`` (MPa) of a spur case (default
     ``cases/fzg_spur.toml``) at its torque: ``Ft = 2 T2 / d2``."""
-    from fegear.pipeline.pair import build_pair
-
     case = case or _fzg_case()
     pair = build_pair(case)
     p, g = pair.pinion, pair.gear
@@ -323,8 +330,6 @@ def fzg_reference(case=None) -> dict[str, tuple[RootFactors, float]]:
 def _fzg_case():
     from pathlib import Path
 
-    from fegear.api import load_case
-
     return load_case(Path(__file__).resolve().parents[2] / "cases" / "fzg_spur.toml")
 
 
@@ -335,10 +340,6 @@ def single_contact_phi1(pair) -> dict[str, float]:
     contact A) and of the gear (B, ``p_b`` before the end E), from the pitch point angle
     (:func:`fegear.validation.rows.pitch_point_phi1`) and ``r_b1`` of travel per radian; the sense
     of travel is read from the TCA (the pinion contact radius grows towards the pinion tip)."""
-    from fegear.geometry.transforms import apply_points, inverse
-    from fegear.tca import TCA, TCAOptions, reference_phase
-    from fegear.validation.rows import pitch_point_phi1
-
     p, g, asm = pair.pinion, pair.gear, pair.assembly
     phi_c = pitch_point_phi1(pair)
     a_w = float(asm.axes_distance())
@@ -425,11 +426,6 @@ def fe_root_stress(
     (:func:`single_contact_phi1`, :class:`FERootStress`): one loaded analysis over both windows,
     then one stress solve per member. Returns ``({"pinion": …, "gear": …}, run)`` with
     ``run = (pair, asm, models, cycle, phi2)``."""
-    from fegear.ltca import LTCAOptions, build_models, run_ltca
-    from fegear.pipeline.fields import displacements
-    from fegear.pipeline.pair import build_pair
-    from fegear.tca.results import ARCSEC
-
     t0 = time.perf_counter()
     case = case or _fzg_case()
     pair = build_pair(case)
@@ -488,8 +484,6 @@ def rows(levels: tuple[int, ...] = (0, 1), fidelity: str = "hybrid", case=None) 
     """The root-stress rows of ``docs/validation.md`` (:class:`fegear.validation.Row`): per
     member, ISO 6336-3 σF0 at the outer point of single contact against fegear's tension-fillet
     maximum principal stress at ``fidelity`` and each of ``levels``."""
-    from fegear.validation import Row, Value
-
     case = case or _fzg_case()
     ref = fzg_reference(case)
     runs = [fe_root_stress(fidelity, lv, case)[0] for lv in levels]

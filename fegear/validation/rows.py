@@ -45,7 +45,11 @@ from pathlib import Path
 
 import numpy as np
 
+from fegear.api import load_case, run
 from fegear.errors import FegearError, InputError
+from fegear.ltca import LTCAOptions, run_ltca
+from fegear.pipeline.pair import build_pair
+from fegear.tca import TCA, TCAOptions, reference_phase
 from fegear.validation import Row, Value, as_row
 from fegear.validation.iso6336 import pitch_point_line_hertz, single_stiffness
 
@@ -78,8 +82,6 @@ TESTS = "tests/test_validation.py"
 
 
 def _case(name: str):
-    from fegear.api import load_case
-
     return load_case(CASES / name)
 
 
@@ -93,9 +95,7 @@ def hertz_scene_rows(
 ) -> list[Row]:
     """Hertz scene (``cases/hertz_scene.toml``): p0, a, b at each fidelity and level against the
     closed-form Hertz point contact (:func:`fegear.scenes.hertz_scene.hertz_reference`, from
-    :mod:`fegear.hertz`). Three rows: p0 (MPa), a (mm), b (mm)."""
-    from fegear.api import run
-
+    :mod:`fegear.mechanics.hertz_closed_form`). Three rows: p0 (MPa), a (mm), b (mm)."""
     case = _case("hertz_scene.toml")
     vals: dict[str, list[Value]] = {"p0": [], "a": [], "b": []}
     ref = None
@@ -112,7 +112,8 @@ def hertz_scene_rows(
         raise InputError("levels", (fe_levels, hybrid_levels), "at least one level")
     s = case.scene
     src = (
-        f"Hertz point contact, closed form (Johnson 1985 §4.2; `fegear/hertz.py`): roller "
+        "Hertz point contact, closed form (Johnson 1985 §4.2; "
+        f"`fegear/mechanics/hertz_closed_form.py`): roller "
         f"R {s.roller_radii_mm[0]:g}/{s.roller_radii_mm[1]:g} mm on a flat, {s.force_N:g} N, "
         f"E {s.E_roller_MPa:g} MPa, ν {s.nu_roller:g}"
     )
@@ -173,8 +174,6 @@ def pitch_point_phi1(pair, n_samples: int = 17) -> float:
     FegearError
         No pair passes through the pitch point (not a conjugate spur pair).
     """
-    from fegear.tca import TCA, TCAOptions, reference_phase
-
     asm = pair.assembly
     opt = TCAOptions()
     asm = asm.with_phase2(reference_phase(pair.pinion, pair.gear, asm, opt))
@@ -278,9 +277,6 @@ def pitch_point_run(fidelity: str = "hybrid", level: int = 0, case=None) -> Pitc
     case
         A spur :class:`~fegear.io.gear_case.GearCase` (its torque, material and backend).
     """
-    from fegear.ltca import LTCAOptions, run_ltca
-    from fegear.pipeline.pair import build_pair
-
     case = case or _case("fzg_spur.toml")
     t0 = time.perf_counter()
     pair = build_pair(case)
@@ -438,8 +434,6 @@ class BevelParabola:
 def bevel_te_parabola(case=None, n_positions: int | None = None) -> BevelParabola:
     """Rigid TCA of the nominal spiral bevel (``cases/spiral_bevel_nominal.toml``) and its TE
     parabola (module docstring)."""
-    from fegear.api import run
-
     case = case or _case("spiral_bevel_nominal.toml")
     if n_positions is not None:
         case = case.replace(n_positions=n_positions)
@@ -568,8 +562,6 @@ def trend_point(
     """The seed face gear case ``name`` (one of :data:`TREND_CASES`) at one fidelity: its
     :class:`TrendPoint`. ``workers`` processes solve the positions (the result does not depend
     on it; each worker holds the operators: one keeps the memory low)."""
-    from fegear.api import run
-
     case = _case(name)
     t0 = time.perf_counter()
     r = run(case, fidelity=fidelity, level=level, workers=workers)

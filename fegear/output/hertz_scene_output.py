@@ -17,98 +17,16 @@ Files written to the output folder:
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from fegear.results.records import solver_record, versions
-from fegear.scenes.hertz_scene import HertzLevelResult, HertzScene
+from fegear.results.hertz_scene import HertzLevel, HertzSceneResult, hertz_summary_document
+from fegear.scenes.hertz_scene import HertzLevelResult
 from fegear.store.files import atomic_write, write_json
 
-__all__ = ["write_hertz_outputs", "hertz_summary", "level_row"]
-
-
-def level_row(r: HertzLevelResult) -> dict[str, object]:
-    """One row of the per-level table (JSON-ready)."""
-    return {
-        "level": r.level,
-        "fidelity": r.fidelity,
-        "cells_across_minor": r.cells_across_minor,
-        "cell_size_mm": r.cell_size_mm,
-        "element_size_mm": r.h_fine_mm,
-        "p0_MPa": r.p0_MPa,
-        "p_max_cell_MPa": r.p_max_cell_MPa,
-        "a_mm": r.a_mm,
-        "b_mm": r.b_mm,
-        "a_extent_mm": r.a_extent_mm,
-        "b_extent_mm": r.b_extent_mm,
-        "approach_mm": r.approach_mm,
-        "error_p0": r.error("p0"),
-        "error_a": r.error("a"),
-        "error_b": r.error("b"),
-        "error_approach": r.error("approach"),
-        "n_cells": r.n_cells,
-        "n_active": r.n_active,
-        "dofs": r.dofs,
-        "seconds": r.seconds,
-        "cache_hit": r.cache_hit,
-    }
-
-
-def hertz_summary(
-    case_name: str,
-    scene: HertzScene,
-    r: HertzLevelResult,
-    study: list[HertzLevelResult] | None = None,
-    rate: dict[str, float] | None = None,
-) -> dict[str, object]:
-    """The ``summary.json`` document."""
-    s = r.solution
-    return {
-        "case": case_name,
-        "kind": "hertz_scene",
-        "fidelity": r.fidelity,
-        "units": {"length": "mm", "force": "N", "pressure": "MPa"},
-        "inputs": {
-            "force_N": scene.force_N,
-            "radii_mm": [list(scene.roller_radii_mm), [None, None]],
-            "bodies": ["roller", "block"],
-            "E_MPa": [scene.E_roller_MPa, scene.E_block_MPa],
-            "nu": [scene.nu_roller, scene.nu_block],
-            "symmetry": scene.symmetry,
-            "fidelity": r.fidelity,
-            "level": r.level,
-        },
-        "result": {
-            "p0_MPa": r.p0_MPa,
-            "p_max_cell_MPa": r.p_max_cell_MPa,
-            "a_mm": r.a_mm,
-            "b_mm": r.b_mm,
-            "a_extent_mm": r.a_extent_mm,
-            "b_extent_mm": r.b_extent_mm,
-            "approach_mm": r.approach_mm,
-            "n_cells": r.n_cells,
-            "n_active": r.n_active,
-            "total_force_N": float(r.force.sum() / r.modelled_fraction),
-            "warnings": list(r.warnings),
-        },
-        "hertz": {
-            "p0_MPa": r.hertz.p0_MPa,
-            "a_mm": r.hertz.a_mm,
-            "b_mm": r.hertz.b_mm,
-            "approach_mm": r.hertz.approach_mm,
-        },
-        "errors": {k: r.error(k) for k in ("p0", "a", "b", "approach")},
-        "solver": {
-            **solver_record(s),
-            "backend": r.backend,
-        },
-        "mesh": {"dofs": r.dofs, "cell_size_mm": r.cell_size_mm, "element_size_mm": r.h_fine_mm},
-        "timings_s": r.seconds,
-        "levels": [level_row(x) for x in study] if study else [],
-        "convergence_rate": rate or {},
-        "versions": versions(),
-    }
+__all__ = ["write_hertz_outputs", "plot_convergence"]
 
 
 def _write_bodies(out: Path, r: HertzLevelResult) -> list[Path]:
@@ -200,17 +118,17 @@ def _plot_pressure(out: Path, r: HertzLevelResult) -> Path:
     return path
 
 
-def plot_convergence(out: Path, study: list[HertzLevelResult], rate: dict[str, float]) -> Path:
-    """Errors against Hertz over the levels (log-log in the cell size)."""
+def plot_convergence(out: Path, levels: Sequence[HertzLevel], rate: Mapping[str, float]) -> Path:
+    """Errors against Hertz over the levels of a study (log-log in the cell size)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    h = np.array([r.cell_size_mm for r in study])
+    h = np.array([row.cell_size_mm for row in levels])
     fig, ax = plt.subplots(figsize=(5.5, 4.2), dpi=110)
     for key, mark in (("p0", "o"), ("a", "s"), ("b", "^")):
-        e = np.array([abs(r.error(key)) for r in study])
+        e = np.array([abs(getattr(row, f"error_{key}")) for row in levels])
         lab = f"{key}" + (f" (rate {rate[key]:.2f})" if key in rate else "")
         ax.loglog(h, np.maximum(e, 1e-6), mark + "-", label=lab)
     ax.axhline(0.01, color="gray", ls=":", lw=1)
@@ -225,21 +143,16 @@ def plot_convergence(out: Path, study: list[HertzLevelResult], rate: dict[str, f
     return path
 
 
-def write_hertz_outputs(
-    out: Path,
-    case_name: str,
-    scene: HertzScene,
-    r: HertzLevelResult,
-    study: list[HertzLevelResult] | None = None,
-    rate: dict[str, float] | None = None,
-) -> list[Path]:
-    """Write every output of a Hertz-scene run into ``out``; returns the paths."""
+def write_hertz_outputs(out: Path, result: HertzSceneResult, r: HertzLevelResult) -> list[Path]:
+    """Write every output of a Hertz-scene run into ``out``: ``summary.json`` from the result
+    model (:mod:`fegear.results.hertz_scene`), the VTK files and the pressure map from the fields
+    of the run's level ``r``, the convergence plot from the model's study. Returns the paths."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [write_json(out / "summary.json", hertz_summary(case_name, scene, r, study, rate))]
+    paths = [write_json(out / "summary.json", hertz_summary_document(result))]
     if r.bodies:
         paths += _write_bodies(out, r)
     paths.append(_plot_pressure(out, r))
-    if study and len(study) >= 2:
-        paths.append(plot_convergence(out, study, rate or {}))
+    if len(result.levels) >= 2:
+        paths.append(plot_convergence(out, result.levels, result.convergence_rate))
     return paths

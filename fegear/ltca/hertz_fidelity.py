@@ -13,7 +13,8 @@ the pairs take load in the order of their separations as ``θ`` grows. Milliseco
 once the ``c_i`` are known.
 
 Local law: point contact (the relative curvature of the flanks at the closest point gives
-``A <= B``, :func:`_relative_curvature`, :func:`fegear.hertz.hertz_law`: ``δ = c F^{2/3}``); when
+``A <= B``, :func:`_relative_curvature`, :func:`fegear.mechanics.hertz_closed_form.hertz_law`: ``δ
+= c F^{2/3}``); when
 ``A < 1e-6 B`` the contact is a line of length ``L`` (the extent along the flat direction of the
 band where the separation is within 20 µm of its minimum) and Palmgren's line-contact approach
 for steel, ``δ = 3.84e-5 F^0.9 / L^0.8`` (mm, N; Palmgren 1959, *Ball and Roller Bearing
@@ -23,7 +24,8 @@ peak pressure is Hertz's ``p0 = sqrt(w E* / (π R))`` for the mean line load ``w
 
 Lumped compliance from the FE operators of the sectors, at the pair's closest point: a unit load
 ``w`` on contact cells near it, ``c_i = wᵀ C_FE w − wᵀ S w``, the FE approach minus the half-space
-approach of the same load (both bodies, :mod:`fegear.halfspace`): what the FE carries beyond
+approach of the same load (both bodies, :mod:`fegear.mechanics.halfspace`): what the FE carries
+beyond
 the local contact deformation, which the Hertz law already counts. For a line contact ``w`` is
 uniform on the ``fe`` cells of the band within ``b_i + δ_ref`` (``δ_ref`` the local approach
 under the whole torque on that pair). For a point contact it is a smooth bump on cells of a
@@ -52,15 +54,16 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import brentq
 
-from fegear.assembly import tooth_transform
-from fegear.contact import ContactSolution
+from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.surface import finite_difference_curvatures
 from fegear.geometry.transforms import apply_vectors, compose
-from fegear.halfspace import layout_influence, tangent_layout
-from fegear.hertz import effective_modulus, hertz_law, hertz_line
 from fegear.ltca.grid import pair_cells, separation_at, take_cells, tca_edge_names
+from fegear.ltca.model import cell_load_operators
 from fegear.ltca.results import LoadedPosition, PairContact
 from fegear.ltca.zone import left_out_pairs
+from fegear.mechanics.contact import ContactSolution
+from fegear.mechanics.halfspace import layout_influence, tangent_layout
+from fegear.mechanics.hertz_closed_form import effective_modulus, hertz_law, hertz_line
 from fegear.tca.core import TCA
 from fegear.tca.results import ARCSEC, PositionResult
 
@@ -388,8 +391,6 @@ def _metric(uv: np.ndarray, P: np.ndarray, fm, at) -> tuple[float, float]:
 def _covered(tca, pos, models, cells) -> np.ndarray:
     """``(n,)`` bool: the cells whose consistent loads lie on DOFs both members' compliance
     operators cover (their load DOFs, or constrained DOFs)."""
-    from fegear.ltca.model import cell_load_operators
-
     M1, M2 = tca.asm.placement1(pos.phi1), tca.asm.placement2(pos.phi2)
     ok = np.ones(cells.n, dtype=bool)
     loads = cell_load_operators(models, M1, M2, [cells])

@@ -1,11 +1,10 @@
-"""Case files (TOML): schema and validation.
+"""The Hertz scene's case file (``kind = "hertz_scene"``): its sections, their validation and
+the :class:`HertzCase` they make.
 
 A case names its units in its keys (``force_N``, ``radii_mm``, ``E_MPa``). Unknown keys are
 refused (with the closest known key suggested, which catches a wrong unit suffix), missing required
 keys are refused, and every error names the field, the value and the allowed range
-(:class:`~fegear.errors.InputError`), so the command line can print it as one line.
-
-Hertz scene (``kind = "hertz_scene"``)::
+(:class:`~fegear.errors.InputError`), so the command line can print it as one line::
 
     [case]    kind = "hertz_scene", name = "..."
     [load]    force_N                                   (required, > 0)
@@ -15,20 +14,19 @@ Hertz scene (``kind = "hertz_scene"``)::
     [solver]  backend ("auto" | "pardiso" | "superlu"), fidelity ("fe" | "hybrid"), fe_level
     [study]   levels = [0, 1, 2, ...]   (optional: a mesh-convergence study)
 
-Gear pairs (``kind = "face_gear" | "spur" | "spiral_bevel"``): see :mod:`fegear.io.gear_case`
-(:func:`load_case` returns a :class:`~fegear.io.gear_case.GearCase` for them).
+A case file of any kind is read by :func:`fegear.case_files.load_case`; gear pairs are
+:mod:`fegear.io.gear_case`.
 """
 
 from __future__ import annotations
 
 import difflib
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from fegear.errors import InputError
-from fegear.io.gear_case import ANALYSIS, GearCase
+from fegear.io.gear_case import ANALYSIS, _plain
 from fegear.io.schema import (
     INT_LIST,
     INTEGER,
@@ -40,18 +38,10 @@ from fegear.io.schema import (
     Section,
     check_document,
     check_table,
-    reference_markdown,
 )
 from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, HertzScene
 
-__all__ = [
-    "HertzCase",
-    "GearCase",
-    "load_case",
-    "parse_case",
-    "parse_hertz_case",
-    "reference",
-]
+__all__ = ["SECTIONS", "HertzCase", "parse_hertz_case"]
 
 _D = HertzScene()
 _LEVEL = Range(0, len(CELLS_ACROSS_MINOR) - 1)
@@ -212,8 +202,6 @@ class HertzCase:
         InputError
             An unknown field, or a value the case file would refuse, named as in the case file.
         """
-        from fegear.io.gear_case import _plain
-
         doc = self.to_document()
         source = self.source
         for key, value in changes.items():
@@ -255,27 +243,6 @@ _HERTZ_FIELDS = {
     "fe_level": ("solver", "fe_level"),
     "study_levels": ("study", "levels"),
 }
-
-
-def parse_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase | GearCase:
-    """Validate a parsed TOML document and build the case (dispatch on ``[case] kind``)."""
-    from fegear.io.gear_case import GEAR_KINDS, parse_gear_case
-
-    allowed = ", ".join(repr(k) for k in ("hertz_scene", *GEAR_KINDS))
-    # The kind decides the schema: without it no section list (the Hertz scene's or a gear
-    # pair's) can be right, so the message asks for the kind, not for other sections.
-    if "case" not in data:
-        raise InputError("case", "missing", f"a [case] section with kind = one of {allowed}")
-    if not isinstance(data["case"], dict):
-        raise InputError("case", data["case"], "a TOML table [case]")
-    kind = data["case"].get("kind")
-    if kind is None:
-        raise InputError("case.kind", "missing", f"one of {allowed} (required)")
-    if kind in GEAR_KINDS:
-        return parse_gear_case(data, source)
-    if kind != "hertz_scene":
-        raise InputError("case.kind", kind, f"one of {allowed}")
-    return parse_hertz_case(data, source)
 
 
 def parse_hertz_case(data: dict[str, Any], source: str = "<memory>") -> HertzCase:
@@ -322,46 +289,3 @@ def parse_hertz_case(data: dict[str, Any], source: str = "<memory>") -> HertzCas
         study_levels=tuple(sorted(set(levels))),
         source=source,
     )
-
-
-def load_case(path: str | Path) -> HertzCase | GearCase:
-    """Read and validate a case file; every problem raises :class:`InputError`."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputError("case", str(p), "an existing TOML file")
-    try:
-        # utf-8-sig: a byte-order mark (what Windows editors put at the start) is not TOML
-        data = tomllib.loads(p.read_text(encoding="utf-8-sig"))
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError("case", str(p), "valid TOML", str(exc)) from exc
-    except UnicodeDecodeError as exc:
-        raise InputError("case", str(p), "a UTF-8 text file", str(exc)) from exc
-    return parse_case(data, source=str(p))
-
-
-def reference() -> str:
-    """The case-file reference of every kind (Markdown), from the schema declarations: the
-    content of ``docs/case_files.md`` (``python -m fegear.case > docs/case_files.md``)."""
-    from fegear.io import gear_case
-
-    return "\n".join(
-        [
-            "# Case files",
-            "",
-            "Generated from the schema declarations by `python -m fegear.case > "
-            "docs/case_files.md` (a test keeps it equal). `*` = required. Units are in the key "
-            "names. Unknown sections and keys are refused with the closest known one suggested; "
-            "every error names the field, the value and what is allowed.",
-            "",
-            "## Gear pairs",
-            "",
-            gear_case.reference(),
-            '## Hertz scene (`kind = "hertz_scene"`)',
-            "",
-            reference_markdown(SECTIONS),
-        ]
-    )
-
-
-if __name__ == "__main__":
-    print(reference(), end="")

@@ -1,4 +1,4 @@
-"""Tests of the closed-form Hertz contact (fegear.hertz).
+"""Tests of the closed-form Hertz contact (fegear.mechanics.hertz_closed_form).
 
 The references are independent of the module's Carlson-form evaluation:
 
@@ -24,7 +24,7 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipkm1
 
 from fegear.errors import InputError
-from fegear.hertz import (
+from fegear.mechanics.hertz_closed_form import (
     HertzPoint,
     effective_modulus,
     hertz_ellipse_for_approach,

@@ -1,4 +1,4 @@
-"""The ``hertz`` fidelity at flank edges (issue 30, item 6; fegear/ltca/hertz_model.py): no pair
+"""The ``hertz`` fidelity at flank edges (issue 30, item 6; fegear/ltca/hertz_fidelity.py): no pair
 in contact is dropped for want of a curvature, no edge pressure it cannot compute (None, with the
 reason), and no TE step where the entering pair's closest point leaves a flank edge.
 
@@ -21,7 +21,7 @@ import pytest
 import fegear
 from fegear.ltca import LTCAOptions
 from fegear.ltca.cycle import cycle_tca
-from fegear.ltca.hertz_model import _relative_curvature
+from fegear.ltca.hertz_fidelity import _relative_curvature
 from fegear.pipeline.pair import build_pair
 
 CASES = Path(__file__).resolve().parents[1] / "cases"

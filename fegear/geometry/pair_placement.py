@@ -55,8 +55,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import InputError
-from .geometry.transforms import compose, inverse, rot_x, rot_y, rot_z, translation
+from ..errors import InputError
+from .transforms import compose, inverse, rot_x, rot_y, rot_z, translation
 
 __all__ = [
     "InstallationErrors",

@@ -8,9 +8,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fegear.case import HertzCase
 from fegear.errors import InputError
 from fegear.io.gear_case import ANALYSIS
+from fegear.mechanics.convergence import observed_rate
+from fegear.output.hertz_scene_output import write_hertz_outputs
+from fegear.results.hertz_scene import HertzSceneResult, build_hertz_result
+from fegear.scenes.hertz_case import HertzCase
+from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
+from fegear.store.outputs import inspect_output_folder, output_run
 
 __all__ = ["HertzResult", "run_hertz"]
 
@@ -39,6 +44,9 @@ class HertzResult:
         Warnings of the run.
     level_result
         The run's :class:`~fegear.scenes.hertz_scene.HertzLevelResult` (fields, cells).
+    model
+        The result model (:class:`~fegear.results.hertz_scene.HertzSceneResult`): what
+        ``summary.json`` holds; the numbers above are its.
     """
 
     case: HertzCase
@@ -56,26 +64,15 @@ class HertzResult:
     rates: Mapping[str, float] = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
     level_result: Any = field(default=None, repr=False, compare=False)
+    model: HertzSceneResult | None = field(default=None, repr=False)
 
     def write(self, folder: str | Path, overwrite: bool = False) -> tuple[Path, ...]:
         """Write the files of ``fegear run`` for the scene into ``folder`` (``summary.json``,
         ``block.vtu``, ``roller.vtu``, ``contact_cells.vtu``, ``pressure_map.png``,
         ``convergence.png`` with a study): one run per folder, as :meth:`GearResult.write`.
         Returns the paths."""
-        from fegear.output.hertz_output import write_hertz_outputs
-        from fegear.store.outputs import inspect_output_folder, output_run
-
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
-            return tuple(
-                write_hertz_outputs(
-                    out,
-                    self.case.name,
-                    self.case.scene,
-                    self.level_result,
-                    list(self.study) or None,
-                    dict(self.rates),
-                )
-            )
+            return tuple(write_hertz_outputs(out, self.model, self.level_result))
 
 
 def run_hertz(
@@ -86,10 +83,8 @@ def run_hertz(
     study: Sequence[int] | None,
     progress=None,
 ) -> HertzResult:
-    """Run the Hertz scene (:func:`fegear.api.run` with a :class:`~fegear.case.HertzCase`)."""
-    from fegear.convergence import observed_rate
-    from fegear.scenes.hertz_scene import CELLS_ACROSS_MINOR, run_level
-
+    """Run the Hertz scene (:func:`fegear.api.run` with a
+    :class:`~fegear.scenes.hertz_case.HertzCase`)."""
     n = len(CELLS_ACROSS_MINOR)
     if backend is not None:
         ANALYSIS.key("backend").check("backend", backend)  # the case file's rule
@@ -119,20 +114,22 @@ def run_hertz(
                 pass
     say("run", None, None)
     res = run_level(case.scene, level, with_fields=True, **kw)  # logs its warnings
+    model = build_hertz_result(case.name, case.scene, res, rows, rates)
     return HertzResult(
         case=case,
-        fidelity=fidelity,
-        level=level,
-        p0_MPa=res.p0_MPa,
-        a_mm=res.a_mm,
-        b_mm=res.b_mm,
-        approach_mm=res.approach_mm,
-        hertz_p0_MPa=res.hertz.p0_MPa,
-        hertz_a_mm=res.hertz.a_mm,
-        hertz_b_mm=res.hertz.b_mm,
-        errors={k: res.error(k) for k in ("p0", "a", "b", "approach")},
+        fidelity=model.fidelity,
+        level=model.inputs.level,
+        p0_MPa=model.result.p0_MPa,
+        a_mm=model.result.a_mm,
+        b_mm=model.result.b_mm,
+        approach_mm=model.result.approach_mm,
+        hertz_p0_MPa=model.hertz.p0_MPa,
+        hertz_a_mm=model.hertz.a_mm,
+        hertz_b_mm=model.hertz.b_mm,
+        errors=dict(model.errors),
         study=tuple(rows),
-        rates=rates,
-        warnings=tuple(res.warnings),
+        rates=dict(model.convergence_rate),
+        warnings=model.result.warnings,
         level_result=res,
+        model=model,
     )

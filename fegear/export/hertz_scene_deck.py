@@ -1,6 +1,6 @@
 """The Hertz scene (:mod:`fegear.scenes.hertz_scene`) as a CalculiX/Abaqus deck.
 
-The same bodies as fegear's scene (:mod:`fegear.mesh.hertz_bodies`: the block and the lower
+The same bodies as fegear's scene (:mod:`fegear.mesh.hertz_scene_bodies`: the block and the lower
 half of the crowned roller, a quarter of each with ``symmetry = "quarter"``), meshed with the
 same size field around the Hertz ellipse at the element size ``element_mm``, as C3D10 elements
 whose mid-edge nodes on the roller's barrel lie on the exact barrel. Conditions, as fegear's:
@@ -32,7 +32,7 @@ from fegear.export.deck import (
     nset_lines,
 )
 from fegear.export.inp import Tet10Body, tet10_body, write_body
-from fegear.mesh.hertz_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh
+from fegear.mesh.hertz_scene_bodies import BodyMeshSpec, cached_body_mesh, read_tet_mesh
 from fegear.scenes.hertz_scene import HertzScene, hertz_reference
 
 __all__ = ["hertz_deck", "barrel_projection", "PRELOAD_APPROACH"]
@@ -43,7 +43,7 @@ PRELOAD_APPROACH = 0.7
 
 
 def barrel_projection(Rx: float, Ry: float):
-    """Closest points on the roller's barrel (``fegear.mesh.hertz_bodies.roller_height``):
+    """Closest points on the roller's barrel (``fegear.mesh.hertz_scene_bodies.roller_height``):
     the meridian circle of radius ``Ry`` about ``(0, 0, Ry)`` in the plane ``x = 0``, revolved
     about the axle ``(0, y, Rx)``. A point ``x`` is moved radially in its section ``y = const``
     to the section radius ``r(y) = Rx − z_m(y)``, ``z_m = Ry − sqrt(Ry² − y²)`` (exact for the
@@ -134,7 +134,7 @@ def hertz_deck(
         f"{scene.force_N:g} N ({'quarter model' if quarter else 'full model'}), "
         f"contact elements {element_mm:g} mm\n"
     )
-    out.write("** units: mm, N, MPa. Written by fegear (fegear.export.hertz_deck).\n")
+    out.write("** units: mm, N, MPa. Written by fegear (fegear.export.hertz_scene_deck).\n")
     nb = len(block.nodes)
     write_body(out, block, 0, 0)
     write_body(out, roller, nb, len(block.elements))
