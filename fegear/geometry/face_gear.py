@@ -44,7 +44,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -66,6 +66,9 @@ from .surface import (
 )
 from .transforms import rot_y, rot_z, translation
 from .validation import validate_face_gear
+
+if TYPE_CHECKING:
+    from .face_gear_native import FaceGearNativeFlank
 
 __all__ = ["FaceGearDesign", "FaceGearMember", "ShaperTool", "closed_form_point"]
 
@@ -431,6 +434,13 @@ class FaceGearMember:
     def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
         """Exact points and normals, fillet included (:meth:`point_normal`)."""
         return self.point_normal(side, u, v)
+
+    def native_flank(self, side: Side) -> FaceGearNativeFlank:
+        """The ``side`` flank in the shaper parameters ``(t, u_s)`` with exact tangents, for
+        closest-point searches (:mod:`.face_gear_native`)."""
+        from .face_gear_native import FaceGearNativeFlank
+
+        return FaceGearNativeFlank(self, side)
 
     def flank_coordinates(self, side: Side) -> FlankCoordinates:
         """Working flank (:meth:`boundaries`, the same for both sides); Litvin's closed form
