@@ -230,3 +230,23 @@ def test_native_flank_closest_point_is_the_normal_offset(seed, side):
     np.testing.assert_allclose(pt, fd, rtol=0, atol=1e-5 * np.abs(pt).max())
     fd = (nf.evaluate(t, us + 1e-4)[0] - nf.evaluate(t, us - 1e-4)[0]) / 2e-4
     np.testing.assert_allclose(pu, fd, rtol=0, atol=1e-7)
+
+
+def test_limits_restored_from_their_record_are_the_solved_ones(seed, monkeypatch):
+    """A member of the same design given the seed's :meth:`limit_record` (through JSON, as the
+    cache keeps it) has the same limits and fillet-limit curves, bit for bit, without solving
+    them (no call of the undercut-limit search)."""
+    import json
+
+    record = json.loads(json.dumps(seed.limit_record()))
+    twin = FaceGearMember(FaceGearDesign())
+    # a solve would fail: the limits and tables must come from the record
+    monkeypatch.setattr(FaceGearMember, "inner_limit", None)
+    monkeypatch.setattr(FaceGearMember, "fillet_limit", None)
+    twin.restore_limits(record)
+    assert twin.limits == seed.limits
+    L = np.linspace(471.0, 560.0, 37)
+    for side in ("drive", "coast"):
+        assert np.array_equal(twin.fillet_height(L, side), seed.fillet_height(L, side))
+        u = np.linspace(-1.0, 1.0, 9)[:, None]
+        assert np.array_equal(twin.height(u, L, side), seed.height(u, L, side))
