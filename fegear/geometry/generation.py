@@ -26,6 +26,7 @@ terminates; the residual ``|n·v|/|v|`` (regularised where v = 0) is reported.
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -94,11 +95,23 @@ def tool_sample(
     return ToolSample(r=r, r_u=r_u, r_t=r_t, n=s * n, n_u=s * n_u, n_t=s * n_t)
 
 
+@functools.lru_cache(maxsize=256)
+def _poly_coeffs(c: tuple[float, ...]) -> tuple[Array, Array, Array]:
+    """Coefficients of ``c0 + c1 ψ + c2 ψ² + ...`` and of its first two derivatives (a motion
+    keeps its coefficients: derived once, not at every evaluation)."""
+    p = np.polynomial.polynomial
+    a = np.asarray(c, dtype=float)
+    out = (a, p.polyder(a), p.polyder(a, 2))
+    for x in out:
+        x.setflags(write=False)
+    return out
+
+
 def _poly(c: Sequence[float], psi: Array) -> tuple[Array, Array, Array]:
     """Value, first and second derivative of ``c0 + c1 ψ + c2 ψ² + ...``."""
-    p = np.polynomial.polynomial
-    c = np.asarray(c, dtype=float)
-    return p.polyval(psi, c), p.polyval(psi, p.polyder(c)), p.polyval(psi, p.polyder(c, 2))
+    c0, c1, c2 = _poly_coeffs(tuple(float(x) for x in c))
+    pv = np.polynomial.polynomial.polyval
+    return pv(psi, c0), pv(psi, c1), pv(psi, c2)
 
 
 @dataclass(frozen=True)
