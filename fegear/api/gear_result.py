@@ -73,6 +73,7 @@ class GearResult:
     model: GearRunResult = field(repr=False, compare=False)
     run: GearRun = field(repr=False, compare=False)
     _views: FlankViews | None = field(default=None, repr=False, compare=False)
+    _workers: int | None = field(default=1, repr=False, compare=False)
 
     @property
     def summary(self) -> dict[str, Any]:
@@ -105,7 +106,8 @@ class GearResult:
         atomically, ``summary.json`` last. The folder holds one run
         (:mod:`fegear.store.outputs`): the files of an earlier run written there are removed
         first, and a folder with files fegear did not write is refused unless ``overwrite``
-        (then its other files are kept). Returns the paths.
+        (then its other files are kept). A run given two or more workers draws the pictures in
+        a second process while the VTK files are written. Returns the paths.
 
         Raises
         ------
@@ -117,7 +119,7 @@ class GearResult:
         from fegear.store.outputs import inspect_output_folder, output_run
 
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
-            return tuple(write_gear_outputs(out, self.run, self._views, self.model))
+            return tuple(write_gear_outputs(out, self.run, self._views, self.model, self._workers))
 
     def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:
         """Root stress of each tooth of ``member`` (``"pinion"``/``"gear"``) that can touch:
@@ -171,9 +173,10 @@ class GearResult:
         )
 
 
-def gear_result(run: GearRun, views: FlankViews) -> GearResult:
+def gear_result(run: GearRun, views: FlankViews, workers: int | None = 1) -> GearResult:
     """The :class:`GearResult` of a run: its result model, built once
-    (:func:`fegear.results.build_result`)."""
+    (:func:`fegear.results.build_result`); ``workers``: the processes the run was given (its
+    :meth:`~GearResult.write` draws the pictures in a second process with two or more)."""
     from fegear.results.build import build_result
 
     model = build_result(run, views.pattern)
@@ -191,4 +194,5 @@ def gear_result(run: GearRun, views: FlankViews) -> GearResult:
         model=model,
         run=run,
         _views=views,
+        _workers=workers,
     )
