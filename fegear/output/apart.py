@@ -5,7 +5,8 @@ Drawing the PNGs of a run (matplotlib: importing it, laying out and rasterising 
 takes about as long as writing its VTK files and its summary; neither reads what the other
 writes, so on a machine with a second core they run side by side. The child is a fork of this
 process (it sees the run as it is, nothing is sent to it) and sends back only what the work
-returns (the paths written). Where this process cannot fork (not POSIX, a daemonic process), or
+returns (the paths written); it ends with the caller, as the workers of the positions do.
+Where this process cannot fork (not POSIX, a daemonic process), or
 the caller keeps to one process, the work runs here when its result is asked for; so it does if
 the child fails, which raises the error here, where the caller sees it.
 """
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import logging
 import multiprocessing
+import os
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -23,11 +25,19 @@ log = logging.getLogger(__name__)
 T = TypeVar("T")
 
 
-def _child(work: Callable[[], object], conn) -> None:
+def _child(work: Callable[[], object], conn, parent: int) -> None:
+    # ends with the caller however it ends, as the workers of the positions do
+    from fegear.ltca.cycle import _die_with_parent
+
+    _die_with_parent(parent)
     try:
-        conn.send(("done", work()))
+        result: tuple[str, object] = ("done", work())
     except BaseException as exc:  # noqa: BLE001 (reported to the parent, which redoes the work)
-        conn.send(("failed", f"{type(exc).__name__}: {exc}"))
+        result = ("failed", f"{type(exc).__name__}: {exc}")
+    try:
+        conn.send(result)
+    except OSError:  # the caller is gone
+        pass
     finally:
         conn.close()
 
@@ -42,7 +52,7 @@ def apart(work: Callable[[], T], fork: bool) -> Callable[[], T]:
         return work
     ctx = multiprocessing.get_context("fork")
     recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(work, send), name="fegear-apart")
+    proc = ctx.Process(target=_child, args=(work, send, os.getpid()), name="fegear-apart")
     try:
         proc.start()
     except OSError as exc:  # out of processes or memory: here instead
