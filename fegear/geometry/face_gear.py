@@ -67,13 +67,13 @@ from .surface import (
 from .transforms import rot_y, rot_z, translation
 from .validation import validate_face_gear
 
-if TYPE_CHECKING:
-    from .face_gear_native import FaceGearNativeFlank
-
 __all__ = ["FaceGearDesign", "FaceGearMember", "ShaperTool", "closed_form_point"]
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
+
+if TYPE_CHECKING:
+    from .face_gear_native import FaceGearNativeFlank
 
 
 @dataclass(frozen=True)
