@@ -87,8 +87,9 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--workers",
         type=int,
-        help="gear pairs: processes solving the mesh positions (default: one per core); the "
-        "result does not depend on it",
+        help="gear pairs: processes solving the mesh positions, and with two or more the "
+        "pictures drawn beside the VTK files (default: one per core); the result does not "
+        "depend on it",
     )
     r.add_argument(
         "--root-stress",

@@ -346,3 +346,20 @@ def test_no_source_file_uses_pickle():
         if "allow_pickle=True" in text.replace(" ", ""):
             found.append(f"{path}: allow_pickle=True")
     assert not found, found
+
+
+def test_face_gear_limits_are_read_back_from_the_cache(private_cache):
+    """The second pair of a face-gear case reads its limits and fillet-limit tables from the
+    cache (one hit, nothing built) and they are the solved ones, bit for bit."""
+    import fegear
+    from fegear.pipeline.pair import build_pair
+    from fegear.store.cache import record_cache_use
+
+    case = fegear.load_case(PACKAGE.parent / "cases" / "face_gear_nominal.toml")
+    first = build_pair(case).gear
+    with record_cache_use() as used:
+        again = build_pair(case).gear
+    assert used().hits == {"face_gear_limits": 1} and not used().built
+    assert again.limits == first.limits
+    L = np.linspace(471.0, 560.0, 19)
+    assert np.array_equal(again.fillet_height(L, "coast"), first.fillet_height(L, "coast"))

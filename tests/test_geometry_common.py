@@ -53,6 +53,44 @@ def test_motion_derivatives_match_finite_differences():
                                atol=1e-8)  # fmt: skip
 
 
+def _bits(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a).view(np.uint64)  # bit patterns: -0.0 differs from 0.0
+
+
+@pytest.mark.parametrize("first", ["fixed", "moving"])
+def test_motion_over_a_stack_is_the_motion_of_each_point(first):
+    """The matrices of a stack of ψ (products batched over the stack) are those of each ψ alone,
+    bit for bit: a point's generated surface does not depend on the points solved with it."""
+    head = (Fixed(compose(rot_z(0.3), translation([0.0, 0.0, 80.0]))),) if first == "fixed" else ()
+    oblique = compose(rot_axis([1.0, 2.0, 3.0], 0.7), translation([5.0, -2.0, 1.0]))
+    mo = Motion(
+        head + (Rotation("z", (0.1, -0.7, 0.05)), Translation((1, 0, 0), (0.0, 3.0)),
+                Fixed(oblique), Fixed(rot_y(np.pi / 2)), Rotation("x", (0.0, 1.0)))
+    )  # fmt: skip
+    psi = np.random.default_rng(1).uniform(-0.6, 0.6, (9, 11))
+    psi[0, :2] = 0.0, -0.0
+    stack = mo.matrices(psi)
+    for i, j in [(0, 0), (0, 1), (4, 7), (8, 10)]:
+        one = mo.matrices(psi[i, j])
+        for S, M in zip(stack, one, strict=True):
+            assert np.array_equal(_bits(S[i, j]), _bits(M))
+
+
+def test_envelope_points_do_not_depend_on_their_batch():
+    """The equation of meshing solved for many points at once gives each point what it gives
+    alone, bit for bit (each point's Newton iteration stops on its own test)."""
+    from fegear.geometry.face_gear import FaceGearDesign, FaceGearMember
+
+    fg = FaceGearMember(FaceGearDesign())
+    t = np.linspace(0.35, 0.75, 9)[:, None]
+    us = np.linspace(472.0, 558.0, 8)[None, :]
+    batch = fg.envelope("drive", t, us)
+    for i, j in [(0, 0), (3, 5), (8, 7)]:
+        one = fg.envelope("drive", t[i, 0], us[0, j])
+        for f in ("psi", "points", "normals", "r_u", "r_t", "n_u", "n_t", "residual"):
+            assert np.array_equal(_bits(getattr(batch, f)[i, j]), _bits(getattr(one, f))), f
+
+
 def test_principal_curvatures_sphere_and_saddle_sign():
     # sphere radius 4, outward normal: convex, both +1/4 (exact formula, round-off only)
     u, v = np.array([0.3, 1.0]), np.array([0.2, -0.5])

@@ -199,3 +199,54 @@ def test_flank_with_the_fillet_rows(seed):
     np.testing.assert_allclose(z[0], seed.root_height, atol=1e-9)  # the fillet starts on the root
     assert np.all(np.diff(z, axis=0) > 0)  # and rises to the tip
     assert np.isfinite(fl.kappa).all() and np.all(fl.meshing_residual[f] == 0)
+
+
+@pytest.mark.parametrize("side", ["drive", "coast"])
+def test_native_flank_closest_point_is_the_normal_offset(seed, side):
+    """Points offset along the exact normal by δ from the working flank of a sector tooth lie
+    δ from it: the closest-point search in the shaper parameters ``(t, u_s)`` (exact tangents)
+    finds the foot, and its native parameters map back to the same flank point."""
+    from fegear.mesh.sector_geometry import flank_distance, sector_frame
+
+    fr = sector_frame(seed)
+    rng = np.random.default_rng(3)
+    u = np.concatenate([[fr.u_fillet, fr.u_tip], rng.uniform(fr.u_fillet, fr.u_tip, 14)])
+    v = np.concatenate([[fr.L_start, fr.L_end], rng.uniform(fr.L_start, fr.L_end, 14)])
+    p, n = seed.point_normal(side, u, v)
+    delta = rng.uniform(-0.01, 0.01, len(u))
+    k = rng.integers(-2, 3, len(u))
+    d, _ = flank_distance(fr, side, k, fr.on_tooth(p + delta[:, None] * n, k))
+    # tolerance: the Newton solves stop at 1e-12 mm (point_normal) and 1e-9 of the parameter
+    # ranges (closest point, quadratic convergence: the last step is far below that)
+    np.testing.assert_allclose(d, np.abs(delta), rtol=0, atol=1e-10)
+    nf = seed.native_flank(side)
+    t, us = nf.native(u, v)
+    q, m, pt, pu = nf.evaluate(t, us, tangents=True)
+    np.testing.assert_allclose(q, p, rtol=0, atol=1e-10)  # the same surface point
+    np.testing.assert_allclose(m, n, rtol=0, atol=1e-12)
+    # exact tangents: central differences of the envelope agree to their O(h²) error
+    h = 1e-6
+    fd = (nf.evaluate(t + h, us)[0] - nf.evaluate(t - h, us)[0]) / (2 * h)
+    np.testing.assert_allclose(pt, fd, rtol=0, atol=1e-5 * np.abs(pt).max())
+    fd = (nf.evaluate(t, us + 1e-4)[0] - nf.evaluate(t, us - 1e-4)[0]) / 2e-4
+    np.testing.assert_allclose(pu, fd, rtol=0, atol=1e-7)
+
+
+def test_limits_restored_from_their_record_are_the_solved_ones(seed, monkeypatch):
+    """A member of the same design given the seed's :meth:`limit_record` (through JSON, as the
+    cache keeps it) has the same limits and fillet-limit curves, bit for bit, without solving
+    them (no call of the undercut-limit search)."""
+    import json
+
+    record = json.loads(json.dumps(seed.limit_record()))
+    twin = FaceGearMember(FaceGearDesign())
+    # a solve would fail: the limits and tables must come from the record
+    monkeypatch.setattr(FaceGearMember, "inner_limit", None)
+    monkeypatch.setattr(FaceGearMember, "fillet_limit", None)
+    twin.restore_limits(record)
+    assert twin.limits == seed.limits
+    L = np.linspace(471.0, 560.0, 37)
+    for side in ("drive", "coast"):
+        assert np.array_equal(twin.fillet_height(L, side), seed.fillet_height(L, side))
+        u = np.linspace(-1.0, 1.0, 9)[:, None]
+        assert np.array_equal(twin.height(u, L, side), seed.height(u, L, side))

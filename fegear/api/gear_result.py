@@ -77,6 +77,7 @@ class GearResult:
     model: GearRunResult = field(repr=False, compare=False)
     run: GearRun = field(repr=False, compare=False)
     _views: FlankViews | None = field(default=None, repr=False, compare=False)
+    _workers: int | None = field(default=1, repr=False, compare=False)
 
     @property
     def summary(self) -> dict[str, Any]:
@@ -109,7 +110,8 @@ class GearResult:
         atomically, ``summary.json`` last. The folder holds one run
         (:mod:`fegear.store.outputs`): the files of an earlier run written there are removed
         first, and a folder with files fegear did not write is refused unless ``overwrite``
-        (then its other files are kept). Returns the paths.
+        (then its other files are kept). A run given two or more workers draws the pictures in
+        a second process while the VTK files are written. Returns the paths.
 
         Raises
         ------
@@ -118,7 +120,7 @@ class GearResult:
             ``overwrite`` is False.
         """
         with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
-            return tuple(write_gear_outputs(out, self.run, self._views, self.model))
+            return tuple(write_gear_outputs(out, self.run, self._views, self.model, self._workers))
 
     def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:
         """Root stress of each tooth of ``member`` (``"pinion"``/``"gear"``) that can touch:
@@ -170,9 +172,10 @@ class GearResult:
         )
 
 
-def gear_result(run: GearRun, views: FlankViews) -> GearResult:
+def gear_result(run: GearRun, views: FlankViews, workers: int | None = 1) -> GearResult:
     """The :class:`GearResult` of a run: its result model, built once
-    (:func:`fegear.results.build_result`)."""
+    (:func:`fegear.results.build_result`); ``workers``: the processes the run was given (its
+    :meth:`~GearResult.write` draws the pictures in a second process with two or more)."""
     model = build_result(run, views.pattern)
     return GearResult(
         case=run.case,
@@ -188,4 +191,5 @@ def gear_result(run: GearRun, views: FlankViews) -> GearResult:
         model=model,
         run=run,
         _views=views,
+        _workers=workers,
     )

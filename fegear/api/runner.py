@@ -96,7 +96,8 @@ def run(
         Mesh level, 0 (coarsest) … 4; overrides the case's.
     workers
         Gear pairs: processes solving the mesh positions (None: ``$FEGEAR_WORKERS``, else one
-        per core); the result does not depend on it. Ignored by the Hertz scene.
+        per core), and drawing the pictures beside the VTK files in the result's ``write``
+        (with two or more); the result does not depend on it. Ignored by the Hertz scene.
     backend
         Sparse direct solver ``"auto"``, ``"pardiso"``, ``"superlu"``; overrides the case's.
     root_stress
@@ -163,4 +164,4 @@ def run(
         workers=workers,
         notify=notify,
     )
-    return gear_result(gear_run, flank_views(gear_run))
+    return gear_result(gear_run, flank_views(gear_run), workers)

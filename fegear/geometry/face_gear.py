@@ -44,7 +44,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -71,6 +71,9 @@ __all__ = ["FaceGearDesign", "FaceGearMember", "ShaperTool", "closed_form_point"
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
+
+if TYPE_CHECKING:
+    from .face_gear_native import FaceGearNativeFlank
 
 
 @dataclass(frozen=True)
@@ -319,15 +322,13 @@ class FaceGearMember:
         )
 
     @cached_property
-    def _limit_tables(self) -> dict[str, tuple[CubicSpline, CubicSpline, CubicSpline, float]]:
-        """Per side: cubic splines over the radius of the fillet-limit height ``z_f(L)``, its
-        generating angle ``ψ_f(L)`` and the angle ``ψ_r(L)`` of the fillet bottom, and the sign
-        that orients the fillet normal ``∂r/∂ψ × ∂r/∂u_s`` outward.
+    def _limit_data(self) -> dict[str, dict[str, object]]:
+        """Per side, the nodes of the fillet-limit tables (:attr:`_limit_tables`): radii ``L``,
+        heights ``z``, generating angles ``psi`` and ``psi_r`` (arrays), and ``sign`` (float).
 
         Nodes from 1.5 mm inside the inner radius (not inside the undercut limit) to 3 mm past
         the outer one, 0.05 mm apart at the inner end (where ``z_f`` turns fastest, toward the
-        undercut limit) growing by 6 % to 0.5 mm; the splines agree with the exact curves to
-        ~1e-8 mm (tested).
+        undercut limit) growing by 6 % to 0.5 mm.
         """
         d = self.design
         lo = max(d.inner_radius_mm - 1.5, self.limits[0] + 0.5)
@@ -344,13 +345,50 @@ class FaceGearMember:
             c = np.cross(tr.d_psi, tr.d_us)
             k = int(np.argmax(np.linalg.norm(c, axis=-1)))
             sign = float(np.sign(c[k] @ lim.normals[k]))
+            out[side] = {"L": L, "z": lim.height, "psi": lim.psi, "psi_r": psi_r, "sign": sign}
+        return out
+
+    @cached_property
+    def _limit_tables(self) -> dict[str, tuple[CubicSpline, CubicSpline, CubicSpline, float]]:
+        """Per side: cubic splines over the radius of the fillet-limit height ``z_f(L)``, its
+        generating angle ``ψ_f(L)`` and the angle ``ψ_r(L)`` of the fillet bottom, and the sign
+        that orients the fillet normal ``∂r/∂ψ × ∂r/∂u_s`` outward; on the nodes of
+        :attr:`_limit_data`, where they agree with the exact curves to ~1e-8 mm (tested).
+        """
+        out = {}
+        for side, t in self._limit_data.items():
+            L = t["L"]
             out[side] = (
-                CubicSpline(L, lim.height),
-                CubicSpline(L, lim.psi),
-                CubicSpline(L, psi_r),
-                sign,
+                CubicSpline(L, t["z"]),
+                CubicSpline(L, t["psi"]),
+                CubicSpline(L, t["psi_r"]),
+                t["sign"],
             )
         return out
+
+    def limit_record(self) -> dict[str, object]:
+        """The limits ``(L1, L2)`` and the nodes of the fillet-limit tables as plain JSON data
+        (floats, which JSON writes by their ``repr``: they read back bit for bit), what a run
+        keeps in its cache instead of solving them again (about 1 s;
+        :func:`fegear.pipeline.pair.face_gear_member`)."""
+        return {
+            "limits": [float(x) for x in self.limits],
+            "tables": {
+                side: {k: (v if isinstance(v, float) else [float(x) for x in v])
+                       for k, v in t.items()}
+                for side, t in self._limit_data.items()
+            },
+        }  # fmt: skip
+
+    def restore_limits(self, record: dict[str, object]) -> None:
+        """Take the limits and the fillet-limit tables from a :meth:`limit_record` of a member
+        of the same design instead of solving them (the same numbers)."""
+        L1, L2 = record["limits"]
+        self.__dict__["limits"] = (float(L1), float(L2))
+        self.__dict__["_limit_data"] = {
+            side: {k: (float(v) if k == "sign" else np.array(v, dtype=float)) for k, v in t.items()}
+            for side, t in record["tables"].items()
+        }
 
     def fillet_height(self, L: ArrayLike, side: Side = "drive") -> Array:
         """Height ``z_f`` (mm) of the fillet limit at radii ``L`` (mm): the lower limit of the
@@ -431,6 +469,13 @@ class FaceGearMember:
     def flank_points(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Array, Array]:
         """Exact points and normals, fillet included (:meth:`point_normal`)."""
         return self.point_normal(side, u, v)
+
+    def native_flank(self, side: Side) -> FaceGearNativeFlank:
+        """The ``side`` flank in the shaper parameters ``(t, u_s)`` with exact tangents, for
+        closest-point searches (:mod:`.face_gear_native`)."""
+        from .face_gear_native import FaceGearNativeFlank
+
+        return FaceGearNativeFlank(self, side)
 
     def flank_coordinates(self, side: Side) -> FlankCoordinates:
         """Working flank (:meth:`boundaries`, the same for both sides); Litvin's closed form

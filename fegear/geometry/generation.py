@@ -26,6 +26,7 @@ terminates; the residual ``|n·v|/|v|`` (regularised where v = 0) is reported.
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -94,11 +95,23 @@ def tool_sample(
     return ToolSample(r=r, r_u=r_u, r_t=r_t, n=s * n, n_u=s * n_u, n_t=s * n_t)
 
 
+@functools.lru_cache(maxsize=256)
+def _poly_coeffs(c: tuple[float, ...]) -> tuple[Array, Array, Array]:
+    """Coefficients of ``c0 + c1 ψ + c2 ψ² + ...`` and of its first two derivatives (a motion
+    keeps its coefficients: derived once, not at every evaluation)."""
+    p = np.polynomial.polynomial
+    a = np.asarray(c, dtype=float)
+    out = (a, p.polyder(a), p.polyder(a, 2))
+    for x in out:
+        x.setflags(write=False)
+    return out
+
+
 def _poly(c: Sequence[float], psi: Array) -> tuple[Array, Array, Array]:
     """Value, first and second derivative of ``c0 + c1 ψ + c2 ψ² + ...``."""
-    p = np.polynomial.polynomial
-    c = np.asarray(c, dtype=float)
-    return p.polyval(psi, c), p.polyval(psi, p.polyder(c)), p.polyval(psi, p.polyder(c, 2))
+    c0, c1, c2 = _poly_coeffs(tuple(float(x) for x in c))
+    pv = np.polynomial.polynomial.polyval
+    return pv(psi, c0), pv(psi, c1), pv(psi, c2)
 
 
 @dataclass(frozen=True)
@@ -157,15 +170,57 @@ class Motion:
     factors: tuple[Rotation | Translation | Fixed, ...]
 
     def matrices(self, psi: ArrayLike) -> tuple[Array, Array, Array]:
-        """``M``, ``dM/dψ``, ``d²M/dψ²``, each ``(..., 4, 4)`` (product rule, forward)."""
+        """``M``, ``dM/dψ``, ``d²M/dψ²``, each ``(..., 4, 4)`` (product rule, forward).
+
+        The same products as ``P @ F`` over the stacks, but a product with a constant operand
+        (a :class:`Fixed` factor, its zero derivatives, or the partial product before the first
+        moving factor) is one matrix product over the whole stack instead of one per point: the
+        same BLAS products of the same 4 × 4 blocks, several times faster on long stacks
+        (tested bit for bit against the per-point products)."""
         psi = np.asarray(psi, dtype=float)
-        P = np.broadcast_to(np.eye(4), psi.shape + (4, 4))
-        P1 = np.zeros(P.shape)
-        P2 = np.zeros(P.shape)
+        if psi.size < _BATCH_MIN:
+            P = np.broadcast_to(np.eye(4), psi.shape + (4, 4))
+            P1 = np.zeros(P.shape)
+            P2 = np.zeros(P.shape)
+            for fac in self.factors:
+                F, F1, F2 = fac.matrices(psi)
+                P, P1, P2 = P @ F, P1 @ F + P @ F1, P2 @ F + 2 * (P1 @ F1) + P @ F2
+            return P, P1, P2
+        P, P1, P2 = np.eye(4), np.zeros((4, 4)), np.zeros((4, 4))
         for fac in self.factors:
-            F, F1, F2 = fac.matrices(psi)
-            P, P1, P2 = P @ F, P1 @ F + P @ F1, P2 @ F + 2 * (P1 @ F1) + P @ F2
-        return P, P1, P2
+            if isinstance(fac, Fixed):
+                F = np.asarray(fac.matrix, dtype=float)
+                F1 = F2 = np.zeros((4, 4))
+            else:
+                F, F1, F2 = fac.matrices(psi)
+            P, P1, P2 = (
+                _mm(P, F),
+                _mm(P1, F) + _mm(P, F1),
+                _mm(P2, F) + 2 * _mm(P1, F1) + _mm(P, F2),
+            )
+        shape = psi.shape + (4, 4)
+        return tuple(np.broadcast_to(X, shape) if X.ndim == 2 else X for X in (P, P1, P2))
+
+
+#: stacks shorter than this take the per-point products (the batched ones cost a few copies)
+_BATCH_MIN = 64
+
+
+def _mm(A: Array, B: Array) -> Array:
+    """``A @ B`` for a constant ``(4, 4)`` or a stack ``(..., 4, 4)`` on either side; with one
+    constant operand, one product over the stack (``C B_k`` side by side, ``A_k C`` one above
+    the other)."""
+    if A.ndim == 2 and B.ndim == 2:
+        return A @ B
+    if A.ndim == 2:
+        lead = B.shape[:-2]
+        wide = np.ascontiguousarray(np.moveaxis(B.reshape(-1, 4, 4), 0, 1)).reshape(4, -1)
+        C = (A @ wide).reshape(4, -1, 4)
+        return np.ascontiguousarray(np.moveaxis(C, 1, 0)).reshape(lead + (4, 4))
+    if B.ndim == 2:
+        A = np.ascontiguousarray(A)
+        return (A.reshape(-1, 4) @ B).reshape(A.shape)
+    return A @ B
 
 
 def _mv(M: Array, x: Array, w: float) -> Array:
@@ -276,23 +331,35 @@ def generate(
     a = np.where(has, a, psi0 - half_width)
     b = np.where(has, b, psi0 + half_width)
     x = np.clip(psi0, a, b)
+    # A point that has stopped (converged, or bracket closed) keeps its ψ: its f is the same at
+    # the next iteration and its bracket only shrinks. So only the points still moving are
+    # iterated (a tenth of them after the first step), with the same arithmetic on each.
+    x, a, b, fa, has = (np.array(z, dtype=z.dtype).reshape(-1) for z in (x, a, b, fa, has))
+    flat = [np.broadcast_to(z, u.shape + (3,)).reshape(-1, 3) for z in (ts.r, ts.r_u, ts.r_t,
+            ts.n, ts.n_u, ts.n_t)]  # fmt: skip
+    act = np.arange(x.size)
     for _ in range(max_iter):
-        f, fp, vn = _meshing(ts, motion, x)
+        tk = ToolSample(*(z[act] for z in flat))
+        xk, ak, bk, fak, hk = x[act], a[act], b[act], fa[act], has[act]
+        f, fp, vn = _meshing(tk, motion, xk)
         done = np.abs(f) <= tol * (vn + _PSI_REG * np.abs(fp))
-        left = has & (np.signbit(f) == np.signbit(fa))
-        a = np.where(left, x, a)
-        fa = np.where(left, f, fa)
-        b = np.where(has & ~left, x, b)
+        left = hk & (np.signbit(f) == np.signbit(fak))
+        ak = np.where(left, xk, ak)
+        fak = np.where(left, f, fak)
+        bk = np.where(hk & ~left, xk, bk)
         with np.errstate(divide="ignore", invalid="ignore"):
-            xn = x - f / fp
-        bad = ~np.isfinite(xn) | (xn <= a) | (xn >= b)
-        xn = np.where(bad & has, 0.5 * (a + b), xn)
-        xn = np.where(bad & ~has, np.clip(np.nan_to_num(xn), a, b), xn)
-        small = b - a <= 1e-15 * np.maximum(1.0, np.abs(x))
-        x = np.where(done | small, x, xn)
-        if np.all(done | small):
+            xn = xk - f / fp
+        bad = ~np.isfinite(xn) | (xn <= ak) | (xn >= bk)
+        xn = np.where(bad & hk, 0.5 * (ak + bk), xn)
+        xn = np.where(bad & ~hk, np.clip(np.nan_to_num(xn), ak, bk), xn)
+        small = bk - ak <= 1e-15 * np.maximum(1.0, np.abs(xk))
+        stop = done | small
+        x[act] = np.where(stop, xk, xn)
+        a[act], b[act], fa[act] = ak, bk, fak
+        act = act[~stop]
+        if act.size == 0:
             break
-    return _assemble(ts, motion, x, tol)
+    return _assemble(ts, motion, x.reshape(u.shape), tol)
 
 
 def _assemble(ts: ToolSample, motion: Motion, psi: Array, tol: float) -> Envelope:

@@ -233,7 +233,7 @@ def _one_blas_thread():
     return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
 
 
-def _workers(requested: int | None, n_chunks: int) -> int:
+def process_count(requested: int | None, n_chunks: int) -> int:
     """Processes for ``n_chunks`` chunks: ``requested`` (validated by LTCAOptions), else
     ``$FEGEAR_WORKERS``, else one per core; 1 where this process cannot fork."""
     env = os.environ.get("FEGEAR_WORKERS", "").strip()
@@ -364,7 +364,7 @@ def run_ltca(
     seconds["flanks"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     parts = chunks(len(tca_pos), opt.chunk_positions)
-    workers = _workers(opt.workers, len(parts))
+    workers = process_count(opt.workers, len(parts))
     job = CycleJob(tca, tuple(tca_pos), models, opt, float(torque2_Nmm))
     out = _solve_all(job, parts, workers, progress)
     for _ in range(3):

@@ -427,8 +427,9 @@ def flank_distance(
 
     Closest-point Gauss-Newton on ``|p(a, b) − x|²`` from the nearest point of an
     ``n_grid × n_grid`` sample of the flank. A member with a native flank evaluator
-    (:class:`~fegear.geometry.surface.HasNativeFlank`; the spiral bevel): in its native
-    parameters (the bevel's cutter parameters ``(s, θ)``) with its exact tangents, unbounded;
+    (:class:`~fegear.geometry.surface.HasNativeFlank`; the spiral bevel, the face gear): in its
+    native parameters (the bevel's cutter parameters ``(s, θ)``, the face gear's shaper
+    parameters ``(t, u_s)``) with its exact tangents, unbounded;
     other members: in ``(u, v)`` with finite-difference tangents, ``u`` projected onto the working
     flank ``[u_fillet, u_tip]`` (below it the parameters run onto the fillet). Returns the distances
     ``(m,)`` mm and the parameters ``(m, 2)``.

@@ -81,6 +81,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fegear.output.apart import apart
 from fegear.output.cylindrical_output import plot_line_load
 from fegear.output.flank_view import (
     FlankFrame,
@@ -143,21 +144,27 @@ def write_gear_outputs(
     run: GearRun,
     views: FlankViews | None = None,
     result: GearRunResult | None = None,
+    workers: int | None = 1,
 ) -> list[Path]:
     """Write every output of a gear run into ``out`` (atomically); returns the paths.
 
     ``views``: the run's flank views (:func:`flank_views`), computed if not given; ``result``:
     its result model (:func:`fegear.results.build_result`, with the views' pattern), built if
-    not given.
+    not given. ``workers``: the processes the run may use (None: as the positions,
+    ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
+    are drawn in a second process while the VTK files are written (:mod:`.apart`).
     """
+    from fegear.ltca.cycle import process_count
+
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     views = views if views is not None else flank_views(run)
     result = result if result is not None else build_result(run, views.pattern)
     paths: list[Path] = []
     if run.cycle is not None:
+        plots = apart(lambda: loaded_plots(out, run, result), process_count(workers, 2) > 1)
         paths += write_gear_vtk(out, run, views)
-        paths += loaded_plots(out, run, result)
+        paths += plots()
         if is_cylindrical(run):
             paths.append(plot_line_load(out, run))
     else:

@@ -108,13 +108,32 @@ class FaceGearFamily:
             raise _renamed(exc, None, self._fields, case) from exc
         pinion = _face_gear_pinion(fg)
         try:
-            fg.check_limits()  # undercut and pointing limits (radii, module): ~1 s, no work yet
+            _face_gear_limits(fg)  # undercut and pointing limits (radii, module): no work yet
         except InputError as exc:
             raise _renamed(exc, None, self._fields, case) from exc
         return GearPair(pinion, fg, face_gear_assembly(fg, case.errors, pinion))
 
     def assemble(self, case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:
         return face_gear_assembly(pair.gear, errors, pair.pinion)
+
+
+def _face_gear_limits(fg) -> None:
+    """Check the face gear's undercut and pointing limits (``check_limits``, a refusal raised
+    before anything is written), with the limits and the fillet-limit tables read from the
+    artefact cache when a face gear of the same design was checked before by the same geometry
+    code (solving them takes about 1 s), else solved and cached. The entry is the member's
+    plain-data :meth:`~fegear.geometry.face_gear.FaceGearMember.limit_record` (JSON floats by
+    their ``repr``: the same numbers bit for bit)."""
+    from fegear.store.cache import cached_file
+
+    def build(path: Path) -> None:
+        fg.check_limits()
+        path.write_text(json.dumps(fg.limit_record()), encoding="utf-8")
+
+    path, hit = cached_file("face_gear_limits", {"design": fg.design}, ".json", build)
+    if hit:
+        fg.restore_limits(json.loads(path.read_text(encoding="utf-8")))
+        fg.check_limits()
 
 
 def _face_gear_pinion(fg):

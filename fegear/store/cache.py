@@ -318,6 +318,8 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "handover": _TCA,
         # the synthesized spiral bevel pair (fegear.pipeline.pair)
         "bevel_pair": Producer(("fegear.geometry",), ("numpy", "scipy")),
+        # the face gear's undercut/pointing limits and fillet-limit tables (fegear.pipeline.pair)
+        "face_gear_limits": Producer(("fegear.geometry",), ("numpy", "scipy")),
     }
 )
 
