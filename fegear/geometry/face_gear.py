@@ -44,7 +44,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -54,6 +54,7 @@ from scipy.optimize import brentq
 from ..errors import DesignError, SolverError
 from .design_checks import validate_face_gear
 from .face_gear_fillet import FilletLimit, TipEdge
+from .face_gear_native import FaceGearNativeFlank
 from .generation import Envelope, Fixed, Motion, Rotation, ToolSample, generate
 from .involute import InvoluteDesign, InvoluteMember
 from .surface import (
@@ -71,9 +72,6 @@ __all__ = ["FaceGearDesign", "FaceGearMember", "ShaperTool", "closed_form_point"
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
-
-if TYPE_CHECKING:
-    from .face_gear_native import FaceGearNativeFlank
 
 
 @dataclass(frozen=True)
@@ -473,8 +471,6 @@ class FaceGearMember:
     def native_flank(self, side: Side) -> FaceGearNativeFlank:
         """The ``side`` flank in the shaper parameters ``(t, u_s)`` with exact tangents, for
         closest-point searches (:mod:`.face_gear_native`)."""
-        from .face_gear_native import FaceGearNativeFlank
-
         return FaceGearNativeFlank(self, side)
 
     def flank_coordinates(self, side: Side) -> FlankCoordinates:

@@ -10,8 +10,9 @@ split at a matching point ``y_i = x_i + d e_i`` a depth ``d`` below it (``e_i`` 
 the FE read at depth (where the coarse mesh no longer has to resolve the pressure's near field)
 plus the closed-form compression of the layer ``[0, d]`` of a half-space under uniform pressure
 on rectangular cells (Love 1929 for the surface, the Boussinesq integral below it:
-:func:`fegear.mechanics.halfspace.layout_influence`), each cell laid out in its own tangent plane
-(:func:`fegear.mechanics.halfspace.tangent_layout`: on a flank whose metric varies, one flat map of a grid
+:func:`fegear.mechanics.halfspace.layout_influence`), each cell laid out in its own tangent
+plane (:func:`fegear.mechanics.halfspace.tangent_layout`: on a flank whose metric varies, one
+flat map of a grid
 turned to the patch misplaces the cells; measured 3-20 % on the layer approach); the part of
 the near field the coarse FE carries above ``y_i`` is never used, so nothing is counted twice.
 ``d = min(2h, 0.35 m)`` is tied to the element size, so the layer shrinks as the FE is refined

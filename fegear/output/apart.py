@@ -19,6 +19,8 @@ import os
 from collections.abc import Callable
 from typing import TypeVar
 
+from fegear.ltca.cycle import _die_with_parent
+
 __all__ = ["apart"]
 
 log = logging.getLogger(__name__)
@@ -27,7 +29,6 @@ T = TypeVar("T")
 
 def _child(work: Callable[[], object], conn, parent: int) -> None:
     # ends with the caller however it ends, as the workers of the positions do
-    from fegear.ltca.cycle import _die_with_parent
 
     _die_with_parent(parent)
     try:

@@ -81,6 +81,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fegear.ltca.cycle import process_count
 from fegear.output.apart import apart
 from fegear.output.cylindrical_output import plot_line_load
 from fegear.output.flank_view import (
@@ -154,7 +155,6 @@ def write_gear_outputs(
     ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
     are drawn in a second process while the VTK files are written (:mod:`.apart`).
     """
-    from fegear.ltca.cycle import process_count
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

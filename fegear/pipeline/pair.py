@@ -124,7 +124,6 @@ def _face_gear_limits(fg) -> None:
     code (solving them takes about 1 s), else solved and cached. The entry is the member's
     plain-data :meth:`~fegear.geometry.face_gear.FaceGearMember.limit_record` (JSON floats by
     their ``repr``: the same numbers bit for bit)."""
-    from fegear.store.cache import cached_file
 
     def build(path: Path) -> None:
         fg.check_limits()
