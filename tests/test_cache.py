@@ -231,8 +231,8 @@ def test_a_truncated_operator_is_rebuilt_not_a_failed_run(monkeypatch, tmp_path)
     import numpy as np
     import skfem
 
-    from fegear.compliance import candidate_operator
     from fegear.fem.elasticity import assemble_body
+    from fegear.mechanics.compliance import candidate_operator
 
     monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "c"))
     mesh = skfem.MeshTet.init_tensor(*(np.linspace(0, 1, 4),) * 3).with_boundaries(

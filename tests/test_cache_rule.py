@@ -121,7 +121,7 @@ def test_every_kind_has_a_producer_found_in_this_installation():
         assert all(fcache.dependency_versions(*p.deps).values()), (kind, p.deps)
     assert {"gmsh"} <= set(fcache.PRODUCERS["mesh"].deps)
     assert {"numpy", "scipy", "scikit-fem"} <= set(fcache.PRODUCERS["compliance"].deps)
-    assert {"fegear.fem", "fegear.compliance", "fegear.linalg"} <= set(
+    assert {"fegear.fem", "fegear.mechanics.compliance", "fegear.linalg"} <= set(
         fcache.PRODUCERS["compliance"].code
     )
     # the TCA's code: the pair's placement is fegear/geometry/pair_placement.py, and its

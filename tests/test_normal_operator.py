@@ -1,4 +1,6 @@
-"""The compliance operator on the normal DOFs of surface nodes (fegear.compliance, ``normals``).
+"""The compliance operator on the normal DOFs of surface nodes.
+
+:func:`fegear.mechanics.compliance.candidate_operator` with ``normals``.
 
 A P2 block clamped at its base, loaded on its top face by cells of uniform pressure. With the
 normal basis the operator keeps, at each top node, only the displacement along the node's normal
@@ -19,14 +21,14 @@ import numpy as np
 import pytest
 import skfem
 
-from fegear.compliance import (
+from fegear.errors import InputError
+from fegear.fem.elasticity import assemble_body
+from fegear.mechanics.compliance import (
     body_compliance,
     boundary_normals,
     candidate_operator,
     load_operator,
 )
-from fegear.errors import InputError
-from fegear.fem.elasticity import assemble_body
 
 # Two direct solves of the same SPD system (condition ~1e5) agree to ~1e-12 relative.
 TOL_SOLVE = 1e-9

@@ -279,8 +279,8 @@ def test_a_bad_backend_name_is_refused_on_an_operator_cache_hit(tmp_path, monkey
     """The operator cache skips the solver (and MKL's loading), not the check of the request."""
     import skfem
 
-    from fegear.compliance import candidate_operator
     from fegear.fem.elasticity import assemble_body
+    from fegear.mechanics.compliance import candidate_operator
 
     monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path))
     mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 3)] * 3).with_boundaries(
@@ -337,8 +337,8 @@ def test_operator_on_load_columns_and_its_guard() -> None:
     """An operator kept only on its load columns gives the same loads-to-readings compliance as
     the square one; a load on a free DOF outside its columns is an error, never a silent clamp;
     a load on a clamped DOF does no work and is ignored."""
-    from fegear.compliance import body_compliance, candidate_operator, cross_compliance
     from fegear.fem.elasticity import assemble_body
+    from fegear.mechanics.compliance import body_compliance, candidate_operator, cross_compliance
 
     mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 3)] * 3).with_boundaries(
         {"bottom": lambda x: x[2] < 1e-9}
@@ -372,8 +372,8 @@ def test_an_operator_in_groups_has_the_blocks_of_the_whole_one() -> None:
     """Groups (per loaded tooth: its load DOFs and the layer DOFs read only under them) give
     ``G_ff`` and each group's ``G_{read, load}`` as the whole operator has them (each block the
     inverse of its own Schur complement); the blocks no group asks for are NaN."""
-    from fegear.compliance import candidate_operator
     from fegear.fem.elasticity import assemble_body
+    from fegear.mechanics.compliance import candidate_operator
 
     mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 4)] * 3).with_boundaries(
         {"bottom": lambda x: x[2] < 1e-9}
@@ -422,8 +422,8 @@ def test_inverse_off_block_is_the_rows_off_the_columns(box, reference, backend) 
 def test_an_operator_in_groups_is_read_back_block_for_block(tmp_path, monkeypatch) -> None:
     """An operator in groups is stored as its blocks and read back bit for bit (memory-mapped);
     ``take`` gives any rows and columns, NaN where no block holds them, as ``G`` does."""
-    from fegear.compliance import candidate_operator
     from fegear.fem.elasticity import assemble_body
+    from fegear.mechanics.compliance import candidate_operator
 
     monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path))
     mesh = skfem.MeshTet.init_tensor(*[np.linspace(0.0, 1.0, 4)] * 3).with_boundaries(

@@ -37,9 +37,9 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from fegear.compliance import SurfacePoints, cross_compliance, find_tets, probe_operator
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.ltca.model import cell_load_operators
+from fegear.mechanics.compliance import SurfacePoints, cross_compliance, find_tets, probe_operator
 from fegear.mechanics.halfspace import layout_influence, tangent_layout
 
 __all__ = ["hybrid_compliance", "hybrid_displacement", "refined_sizes"]

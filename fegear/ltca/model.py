@@ -4,9 +4,10 @@ Each member is a sector of ``n`` teeth (:mod:`fegear.mesh.sector`) in its own fr
 bore (or the face-gear base) and at both sector cuts. The candidate DOFs are all DOFs of the
 nodes on the working flanks of the teeth that can engage (and, for ``hybrid``, of a layer below
 them, read but never loaded: the operator keeps only the flank columns): the flank points move
-with the teeth, so one Schur complement (``(K⁻¹)_cc``) serves every mesh position and every torque
-(:func:`fegear.compliance.candidate_operator`, cached on disk by content hash). A mesh position
-then costs only locating its cells on the flank facets (sparse ``P``) and ``C = Pᵀ G P``.
+with the teeth, so one Schur complement (``(K⁻¹)_cc``) serves every mesh position and every
+torque (:func:`fegear.mechanics.compliance.candidate_operator`, cached on disk by content hash). A
+mesh position then costs only locating its cells on the flank facets (sparse ``P``) and
+``C = Pᵀ G P``.
 
 Tooth numbering: member tooth ``k`` is sector tooth ``k + n // 2`` (the sector's centre tooth is
 member tooth 0); a pair whose tooth falls outside the sector cannot be modelled and is reported.
@@ -21,7 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from fegear.compliance import (
+from fegear.errors import InputError
+from fegear.fem.elasticity import ElasticBody, assemble_body
+from fegear.geometry.transforms import apply_points, apply_vectors, inverse
+from fegear.mechanics.compliance import (
     CandidateOperator,
     body_compliance,
     boundary_normals,
@@ -30,9 +34,6 @@ from fegear.compliance import (
     load_operator,
     prepare_locators,
 )
-from fegear.errors import InputError
-from fegear.fem.elasticity import ElasticBody, assemble_body
-from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.mesh.sector import SectorMesh
 from fegear.store.cache import cached_file
 
@@ -97,7 +98,8 @@ class MemberModel:
     def prepare(self) -> None:
         """Build the lazily made structures every mesh position reads: the point locators of
         the mesh and of the working flanks in the operator
-        (:func:`fegear.compliance.prepare_locators`) and the operator's row and column maps.
+        (:func:`fegear.mechanics.compliance.prepare_locators`) and the operator's row and column
+        maps.
         Called by a process before it forks the workers that solve the positions (each would
         otherwise build its own); the positions' numbers do not change."""
         teeth = range(self.sector.n_teeth) if self.teeth is None else self.teeth
@@ -120,9 +122,10 @@ def build_member_model(
     the dense operator costs the cube of its size) and, with ``layer_mm > 0``, on the DOFs of
     the tetrahedra down to that depth below them.
 
-    The operator is cached as blocks (:func:`fegear.compliance.candidate_operator`): the flank
-    block ``(K⁻¹)_ff`` of all those teeth (every fidelity reads it), and with a layer one block
-    ``(K⁻¹)_{l_t f_t}`` per tooth ``t`` (or one for all teeth where their layers meet)."""
+    The operator is cached as blocks
+    (:func:`fegear.mechanics.compliance.candidate_operator`): the flank block ``(K⁻¹)_ff`` of
+    all those teeth (every fidelity reads it), and with a layer one block ``(K⁻¹)_{l_t f_t}``
+    per tooth ``t`` (or one for all teeth where their layers meet)."""
     mesh = sector.to_skfem()
     support = "base" if "base" in mesh.boundaries else "bore"
     clamped = [(support, "xyz"), ("cut_left", "xyz"), ("cut_right", "xyz")]
@@ -135,8 +138,8 @@ def build_member_model(
     facets = np.concatenate(per_tooth)
     dofs = _facet_dofs(body.basis, facets)
     # what the operator blocks depend on besides their DOFs: the mesh and its clamped faces (the
-    # material and the DOFs join in fegear.compliance); not the layer depth or the fidelity, so
-    # that every fidelity reads the same flank block
+    # material and the DOFs join in fegear.mechanics.compliance); not the layer depth or the
+    # fidelity, so that every fidelity reads the same flank block
     key = {
         "mesh": str(sector.path.name) if sector.path else repr(sector.parameters),
         "clamped": clamped,
@@ -192,11 +195,12 @@ def build_member_model(
 def _normals(
     body: ElasticBody, facets: np.ndarray, layer_tets: np.ndarray | None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(s, n)`` for :func:`fegear.compliance.candidate_operator`: the P2 nodes of the working
-    flank ``facets`` with their normals (:func:`fegear.compliance.boundary_normals`) and, with
-    a layer (``layer_tets``, bool per tetrahedron), the other nodes of its tetrahedra, each with
-    the normal of the nearest flank node (the direction the ``hybrid`` fidelity reads at depth
-    below that flank point), sorted by node."""
+    """``(s, n)`` for :func:`fegear.mechanics.compliance.candidate_operator`: the P2 nodes of
+    the working flank ``facets`` with their normals
+    (:func:`fegear.mechanics.compliance.boundary_normals`) and, with a layer (``layer_tets``,
+    bool per tetrahedron), the other nodes of its tetrahedra, each with the normal of the
+    nearest flank node (the direction the ``hybrid`` fidelity reads at depth below that flank
+    point), sorted by node."""
     s, n = boundary_normals(body.mesh, facets)
     if layer_tets is None or not layer_tets.any():
         return s, n

@@ -9,9 +9,12 @@
   rectangular cells (the near field of the ``hybrid`` fidelity);
 - :mod:`~fegear.mechanics.patch` — measures of a computed contact patch (recovered peak pressure,
   semi-axes from second moments);
-- :mod:`~fegear.mechanics.convergence` — observed convergence rates of mesh studies.
+- :mod:`~fegear.mechanics.convergence` — observed convergence rates of mesh studies;
+- :mod:`~fegear.mechanics.compliance` — the FE compliance of a meshed elastic body on contact
+  cells: the operator ``(K⁻¹)`` on its candidate DOFs (Cartesian or along surface normals),
+  the consistent cell loads and readings.
 
-Its modules take plain arrays and import nothing from fegear but :mod:`fegear.errors`
-(``tests/test_architecture.py`` checks it). The FE compliance of meshed bodies is
-:mod:`fegear.compliance`.
+Its modules take plain arrays and meshes and import nothing from fegear but the gear-agnostic
+layers under them: :mod:`fegear.errors`, :mod:`fegear.fem`, :mod:`fegear.linalg` and
+:mod:`fegear.store` (``tests/test_architecture.py`` checks it).
 """

@@ -2,8 +2,9 @@
 
 This is the scene whose answer is known. The same pieces the gear analysis uses run here
 unchanged: gmsh meshes (:mod:`fegear.mesh.hertz_scene_bodies`), scikit-fem stiffness
-(:mod:`fegear.fem`), the Schur-complement compliance on a contact grid (:mod:`fegear.compliance`)
-and the active-set solver (:mod:`fegear.mechanics.contact`); the closed-form Hertz solution
+(:mod:`fegear.fem`), the Schur-complement compliance on a contact grid
+(:mod:`fegear.mechanics.compliance`) and the active-set solver
+(:mod:`fegear.mechanics.contact`); the closed-form Hertz solution
 (:mod:`fegear.mechanics.hertz_closed_form`) is the reference.
 
 Contact grid: square cells of side ``s`` in the common tangent plane ``z = 0`` covering the
@@ -34,16 +35,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fegear.compliance import (
+from fegear.errors import InputError
+from fegear.fem.elasticity import ElasticBody, assemble_body
+from fegear.linalg.solve import factorize_spd
+from fegear.mechanics.compliance import (
     body_compliance,
     candidate_operator,
     cross_compliance,
     load_operator,
     probe_operator,
 )
-from fegear.errors import InputError
-from fegear.fem.elasticity import ElasticBody, assemble_body
-from fegear.linalg.solve import factorize_spd
 from fegear.mechanics.contact import ContactSolution, solve_contact
 from fegear.mechanics.halfspace import subsurface_influence
 from fegear.mechanics.hertz_closed_form import HertzPoint, hertz_point_radii

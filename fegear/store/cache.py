@@ -299,9 +299,9 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         # sector meshes (fegear.mesh.sector) and the Hertz scene's bodies
         # (fegear.mesh.hertz_scene_bodies)
         "mesh": Producer(_MESH_CODE, _MESH_DEPS),
-        # the flank operators (fegear.compliance.candidate_operator) of a meshed body
+        # the flank operators (fegear.mechanics.compliance.candidate_operator) of a meshed body
         "compliance": Producer(
-            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.compliance"), _FE_DEPS
+            (*_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.mechanics.compliance"), _FE_DEPS
         ),
         # the vertex displacements of a contact sector under a run's cell loads (for the VTK
         # files; fegear.pipeline.fields)
