@@ -231,16 +231,16 @@ def test_workers_end_with_their_parent(sig):
 def test_a_worker_whose_parent_died_before_it_was_armed_exits(monkeypatch):
     """The race of PR_SET_PDEATHSIG: armed after the fork, so a parent that died in between is
     seen by the parent-pid check and the worker exits at once."""
-    from fegear.ltca import cycle
+    from fegear import forked
 
     code = subprocess.run(
         [sys.executable, "-c",
-         "import os; from fegear.ltca.cycle import _die_with_parent; "
-         "_die_with_parent(os.getppid() + 1000003); print('survived')"],
+         "import os; from fegear.forked import die_with_parent; "
+         "die_with_parent(os.getppid() + 1000003); print('survived')"],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert code.returncode == 1 and "survived" not in code.stdout
-    assert cycle._PR_SET_PDEATHSIG == 1  # linux/prctl.h
+    assert forked.PR_SET_PDEATHSIG == 1  # linux/prctl.h
 
 
 # --------------------------------------------------------------------------------------------

@@ -24,7 +24,6 @@ import logging
 import math
 import multiprocessing
 import os
-import sys
 import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -36,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from fegear.errors import InputError, SolverError
+from fegear.forked import die_with_parent, process_count
 from fegear.ltca.analysis import (
     LTCAOptions,
     MemberModels,
@@ -136,57 +136,16 @@ def _prepare(models: MemberModels) -> float:
 
 
 def _worker_init(threads: int, parent: int | None = None) -> None:
-    """In a forked worker: an end with its parent ``parent`` (:func:`_die_with_parent`), its
-    share of the cores for the threaded half-space evaluation (row blocks, each computed whole by
-    one thread: the same numbers with any thread count), one BLAS thread
-    (:func:`_one_blas_thread`), and a heap that keeps its pages (:func:`_keep_heap`)."""
+    """In a forked worker: an end with its parent ``parent``
+    (:func:`fegear.forked.die_with_parent`), its share of the cores for the threaded half-space
+    evaluation (row blocks, each computed whole by one thread: the same numbers with any thread
+    count), one BLAS thread (:func:`_one_blas_thread`), and a heap that keeps its pages
+    (:func:`_keep_heap`)."""
     if parent is not None:
-        _die_with_parent(parent)
+        die_with_parent(parent)
     os.environ["FEGEAR_THREADS"] = str(threads)
     _one_blas_thread()  # for the worker's lifetime (never restored)
     _keep_heap()
-
-
-#: ``prctl`` option of Linux: the signal the calling process gets when its parent ends.
-_PR_SET_PDEATHSIG = 1
-
-
-def _die_with_parent(parent: int, poll_s: float = 1.0) -> None:
-    """End this worker when the process that forked it (pid ``parent``) ends, however it ends
-    (SIGTERM of a job manager or ``timeout``, SIGKILL of the OOM killer): the pool's own
-    shutdown never runs then, and a worker holds some hundred MB.
-
-    On Linux the kernel sends SIGKILL to this process when its parent dies
-    (``prctl(PR_SET_PDEATHSIG, SIGKILL)``, set through ctypes); the parent may have died between
-    the fork and that call, so the parent pid is checked after it (a dead parent's orphans are
-    re-parented: ``getppid()`` no longer returns it) and the worker exits at once. The forking
-    thread is the thread that runs the pool (the caller's), alive as long as the pool is. Where
-    ``prctl`` is not available (macOS forks too), a daemon thread polls ``getppid()`` every
-    ``poll_s`` seconds and ends the process when it changes."""
-    import signal
-
-    armed = False
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
-        except (OSError, AttributeError):
-            armed = False
-    if os.getppid() != parent:  # the parent died before the signal was armed
-        os._exit(1)
-    if armed:
-        return
-    import threading
-
-    def watch() -> None:
-        while True:
-            time.sleep(poll_s)
-            if os.getppid() != parent:
-                os._exit(1)
-
-    threading.Thread(target=watch, name="fegear-parent-watch", daemon=True).start()
 
 
 #: glibc ``mallopt`` parameters (``malloc.h``): ``M_TRIM_THRESHOLD``, ``M_MMAP_THRESHOLD``.
@@ -231,25 +190,6 @@ def _one_blas_thread():
     from threadpoolctl import ThreadpoolController
 
     return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
-
-
-def process_count(requested: int | None, n_chunks: int) -> int:
-    """Processes for ``n_chunks`` chunks: ``requested`` (validated by LTCAOptions), else
-    ``$FEGEAR_WORKERS``, else one per core; 1 where this process cannot fork."""
-    env = os.environ.get("FEGEAR_WORKERS", "").strip()
-    if requested is None and env:
-        if not (env.isdigit() and int(env) >= 1):
-            raise InputError("FEGEAR_WORKERS", env, "an integer >= 1")
-        requested = int(env)
-    want = requested if requested is not None else (os.cpu_count() or 1)
-    want = min(want, n_chunks)
-    if want > 1 and (
-        "fork" not in multiprocessing.get_all_start_methods()
-        or multiprocessing.current_process().daemon
-    ):
-        log.info("positions run in this process (no fork here)")
-        return 1
-    return want
 
 
 def _solve_all(job: CycleJob, parts: list[range], workers: int, progress) -> list:
@@ -305,7 +245,7 @@ def cycle_tca(pinion, gear, assembly, options: LTCAOptions, phi1: np.ndarray | N
         n = options.n_positions
         phi1 = -np.pi / assembly.n1 + 2 * np.pi / assembly.n1 * np.arange(n) / n
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
-    return cached_tca(pinion, gear, assembly, tca_opt, phi1)
+    return cached_tca(pinion, gear, assembly, tca_opt, phi1, workers=options.workers)
 
 
 def run_ltca(

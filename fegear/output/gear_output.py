@@ -81,8 +81,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from fegear.ltca.cycle import process_count
-from fegear.output.apart import apart
+from fegear.forked import apart, process_count
 from fegear.output.cylindrical_output import plot_line_load
 from fegear.output.flank_view import (
     FlankFrame,
@@ -153,7 +152,7 @@ def write_gear_outputs(
     its result model (:func:`fegear.results.build_result`, with the views' pattern), built if
     not given. ``workers``: the processes the run may use (None: as the positions,
     ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
-    are drawn in a second process while the VTK files are written (:mod:`.apart`).
+    are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`).
     """
 
     out = Path(out)

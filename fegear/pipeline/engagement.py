@@ -137,12 +137,15 @@ def _jamming(pair: GearPair, case: GearCase) -> str:
     )
 
 
-def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) -> Engagement:
+def check_engagement(
+    case: GearCase, pair: GearPair, tca, positions, clearance, workers: int | None = None
+) -> Engagement:
     """Every way the contact can fail, decided before the loaded analysis.
 
     ``tca``, ``positions``: the TCA of the run's positions (:func:`fegear.tca.cached.cached_tca`,
     the one the loaded analysis reads back); ``clearance``: the pair's tip/root clearances
-    (checked first: an interference is refused before any TCA).
+    (checked first: an interference is refused before any TCA); ``workers``: processes for the
+    TCA positions of the path's ends and the hand-overs (:func:`fegear.tca.parallel.positions`).
 
     Raises
     ------
@@ -164,8 +167,10 @@ def check_engagement(case: GearCase, pair: GearPair, tca, positions, clearance) 
             f"no contact anywhere: the flanks do not meet at any of the {n} positions of the "
             f"cycle; the teeth are separated by {_fields_text(errs)}",
         )
-    h = cached_handover(pair.pinion, pair.gear, pair.assembly, tca.opt, tca)
-    path = cached_contact_path(pair.pinion, pair.gear, pair.assembly, tca.opt, tca, positions)
+    h = cached_handover(pair.pinion, pair.gear, pair.assembly, tca.opt, tca, workers=workers)
+    path = cached_contact_path(
+        pair.pinion, pair.gear, pair.assembly, tca.opt, tca, positions, workers=workers
+    )
     warnings = []
     jam = _jamming(pair, case)
     if jam:

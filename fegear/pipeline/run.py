@@ -196,8 +196,8 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
                          pinion_torque_Nm=case.pinion_torque_Nm)  # fmt: skip
         n = case.n_positions
         phi1 = -np.pi / pair.assembly.n1 + 2 * np.pi / pair.assembly.n1 * np.arange(n) / n
-        tca, positions, _ = cached_tca(pair.pinion, pair.gear, pair.assembly, opt, phi1)
-        eng = check_engagement(case, pair, tca, positions, clearance)
+        tca, positions, _ = cached_tca(pair.pinion, pair.gear, pair.assembly, opt, phi1, workers)
+        eng = check_engagement(case, pair, tca, positions, clearance, workers)
         for w in eng.warnings:
             (notify or log.warning)(w)
         r = cycle_result(list(positions), opt.paint_mm, tca)
@@ -221,7 +221,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
     )
     t0 = time.perf_counter()
     tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
-    eng = check_engagement(case, pair, tca, positions, clearance)  # before the FE work
+    eng = check_engagement(case, pair, tca, positions, clearance, workers)  # before the FE work
     ell = _ellipses(case, tca, positions)
     for w in eng.warnings:
         (notify or log.warning)(w)

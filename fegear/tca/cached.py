@@ -35,6 +35,7 @@ from fegear.store.cache import cached_record
 from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
+from .parallel import positions as parallel_positions
 from .results import PositionResult, from_record, to_record
 
 __all__ = ["CachedTCA", "cached_phase", "cached_tca", "load_arrays", "save_arrays"]
@@ -120,13 +121,19 @@ def cached_phase(pinion, gear, assembly: Assembly, options: TCAOptions) -> float
 
 
 def cached_tca(
-    pinion, gear, assembly: Assembly, options: TCAOptions, phi1: np.ndarray
+    pinion,
+    gear,
+    assembly: Assembly,
+    options: TCAOptions,
+    phi1: np.ndarray,
+    workers: int | None = None,
 ) -> CachedTCA:
     """Phase the assembly (:func:`~fegear.tca.reference_phase`) and run the TCA at ``phi1``
     (rad, ``(n,)``), reading both from the cache when the same pair was analysed before.
 
     Returns the :class:`~fegear.tca.TCA` of the phased assembly (the loaded analysis evaluates
-    its flank maps) and the positions.
+    its flank maps) and the positions. ``workers``: processes for the positions
+    (:func:`fegear.tca.parallel.positions`; the same result with any number).
     """
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
@@ -136,7 +143,7 @@ def cached_tca(
     def build(entry) -> dict[str, object]:
         asm = assembly.with_phase2(phase2)
         tca = TCA(pinion, gear, asm, options)
-        positions = tuple(tca.positions(phi1))
+        positions = tuple(parallel_positions(tca, phi1, workers=workers))
         box["tca"], box["positions"] = tca, positions
         arrays: dict[str, np.ndarray] = {}
         record = {

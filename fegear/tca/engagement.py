@@ -34,6 +34,7 @@ from fegear.store.cache import cached_file
 
 from ..geometry.transforms import apply_points, compose, inverse
 from .cached import pair_key
+from .parallel import positions as parallel_positions
 
 __all__ = [
     "Clearance",
@@ -303,10 +304,11 @@ class Handover:
         return out
 
 
-def _outside(tca, phi: Array) -> NDArray[np.bool_]:
+def _outside(tca, phi: Array, workers: int | None) -> NDArray[np.bool_]:
     """The rigid contact at ``phi`` is absent or on a tip/root boundary."""
     out = []
-    for p in tca.positions(np.asarray(phi, dtype=float), with_grids=False, ellipses=False):
+    phi = np.asarray(phi, dtype=float)
+    for p in parallel_positions(tca, phi, with_grids=False, ellipses=False, workers=workers):
         if not p.has_contact:
             out.append(True)
             continue
@@ -315,19 +317,20 @@ def _outside(tca, phi: Array) -> NDArray[np.bool_]:
     return np.array(out, dtype=bool)
 
 
-def handover(tca, n_samples: int = 48, refine: int = 3) -> Handover:
+def handover(tca, n_samples: int = 48, refine: int = 3, workers: int | None = None) -> Handover:
     """Interior contact over one mesh cycle of ``tca`` (a :class:`~fegear.tca.TCA` of the phased
     assembly), see :class:`Handover`.
 
     The cycle ``[−π/N1, π/N1)`` is sampled at ``n_samples`` positions; each change between
     interior and other contact is then bracketed ``refine`` times by 7 inner points.
+    ``workers``: processes for the positions (:func:`fegear.tca.parallel.positions`).
     """
     n1 = tca.asm.n1
     cycle = 2.0 * math.pi / n1
     phi0 = -math.pi / n1
     step = cycle / n_samples
     phi = phi0 + step * (np.arange(n_samples + 1) + 0.5)  # the last one is the first + cycle
-    bad = _outside(tca, phi[:-1])
+    bad = _outside(tca, phi[:-1], workers)
     bad = np.append(bad, bad[0])
     if not bad[:-1].any():
         return Handover(1.0, (), phi0, cycle)
@@ -340,7 +343,7 @@ def handover(tca, n_samples: int = 48, refine: int = 3) -> Handover:
     for _ in range(refine):
         s = np.linspace(0.0, 1.0, 9)[1:-1]
         x = a[:, None] + (b - a)[:, None] * s[None, :]
-        o = _outside(tca, x.ravel()).reshape(x.shape)
+        o = _outside(tca, x.ravel(), workers).reshape(x.shape)
         for r in range(len(a)):
             flip = np.flatnonzero(o[r] != a_bad[r])
             if flip.size:
@@ -362,7 +365,9 @@ def handover(tca, n_samples: int = 48, refine: int = 3) -> Handover:
     return Handover(max(0.0, 1.0 - outside / cycle), tuple(intervals), phi0, cycle)
 
 
-def cached_handover(pinion, gear, assembly, options, tca, n_samples: int = 48) -> Handover:
+def cached_handover(
+    pinion, gear, assembly, options, tca, n_samples: int = 48, workers: int | None = None
+) -> Handover:
     """:func:`handover` of the pair, read from the artefact cache when the same pair (members,
     assembly with its errors, TCA options: the ``tca`` is the one they give) was checked before
     (FZG 0.3-1.5 s, seed face gear ~1 s, spiral bevel ~2 s otherwise)."""
@@ -372,7 +377,7 @@ def cached_handover(pinion, gear, assembly, options, tca, n_samples: int = 48) -
     box: dict[str, Handover] = {}
 
     def build(path) -> None:
-        h = handover(tca, n_samples)
+        h = handover(tca, n_samples, workers=workers)
         box["h"] = h
         doc = {
             "interior_fraction": h.interior_fraction,

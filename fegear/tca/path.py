@@ -34,6 +34,7 @@ from fegear.store.cache import cached_file
 from ..geometry.transforms import apply_points
 from .cached import pair_key
 from .core import TCA
+from .parallel import positions as parallel_positions
 from .results import PositionResult
 
 __all__ = ["ContactPath", "cached_contact_path", "contact_path"]
@@ -114,35 +115,47 @@ def _samples(tca: TCA, pos: PositionResult, tol_rad: float) -> list[_Sample]:
     return out
 
 
-def _evaluate(tca: TCA, psi: Array, tol_rad: float) -> list[_Sample]:
-    """Pair-0 samples at angles ``psi`` (each solved at ``φ1`` in the central cycle, all pairs)."""
+def _evaluate(tca: TCA, psi: Array, tol_rad: float, workers: int | None) -> list[_Sample]:
+    """Pair-0 samples at angles ``psi`` (each solved at ``φ1`` in the central cycle, all pairs;
+    in up to ``workers`` processes: :func:`fegear.tca.parallel.positions`)."""
     tau = 2 * np.pi / tca.asm.n1
     m_of = -tca.asm.sense1 * tca.pairs[:, 0]
     shift = np.round(np.asarray(psi) / tau)
     shift = np.clip(-shift, m_of.min(), m_of.max())
     phi1 = np.asarray(psi) + shift * tau
     out = []
-    for p, s in zip(tca.positions(phi1, with_grids=False, ellipses=False), shift, strict=True):
+    done = parallel_positions(tca, phi1, with_grids=False, ellipses=False, workers=workers)
+    for p, s in zip(done, shift, strict=True):
         i = int(np.flatnonzero(m_of == s)[0])
         out.append(_samples(tca, p, tol_rad)[i])
     return out
 
 
-def _refine(tca: TCA, a: _Sample, b: _Sample, tol_rad: float, rounds: int) -> tuple[_Sample, ...]:
-    """Bracket ``a`` (inside) / ``b`` (outside) shrunk by batched bisection: (inside, outside)."""
+def _refine(
+    tca: TCA,
+    brackets: list[tuple[_Sample, _Sample]],
+    tol_rad: float,
+    rounds: int,
+    workers: int | None,
+) -> list[tuple[_Sample, _Sample]]:
+    """Brackets ``(a, b)`` (``a`` inside, ``b`` outside) shrunk by batched bisection, 8 inner
+    points per bracket and round, the points of all brackets in one batch of positions (each
+    position is independent of its batch: the brackets come out as refined one by one)."""
+    brackets = list(brackets)
     for _ in range(rounds):
-        psi = np.linspace(a.psi, b.psi, 10)[1:-1]
-        s = _evaluate(tca, psi, tol_rad)
-        ins = [x.inside for x in s]
-        k = ins.index(False) if False in ins else len(s)
-        a = s[k - 1] if k > 0 else a
-        b = s[k] if k < len(s) else b
-    return a, b
+        psi = [np.linspace(a.psi, b.psi, 10)[1:-1] for a, b in brackets]
+        flat = _evaluate(tca, np.concatenate(psi), tol_rad, workers) if psi else []
+        for j, (a, b) in enumerate(brackets):
+            s = flat[8 * j : 8 * j + 8]
+            ins = [x.inside for x in s]
+            k = ins.index(False) if False in ins else len(s)
+            brackets[j] = (s[k - 1] if k > 0 else a, s[k] if k < len(s) else b)
+    return brackets
 
 
 def contact_path(
     tca: TCA, positions: list[PositionResult] | tuple[PositionResult, ...],
-    tol_rad: float = 1e-9, rounds: int = 4,
+    tol_rad: float = 1e-9, rounds: int = 4, workers: int | None = None,
 ) -> ContactPath | None:  # fmt: skip
     """Pair 0's contact interval and path from the positions of one cycle (see module docstring).
 
@@ -156,7 +169,9 @@ def contact_path(
         A pair within ``tol_rad`` of the smallest closing rotation is in contact (1e-9 rad:
         0.5 nm at a 500 mm radius; conjugate pairs tie to ~1e-12 rad).
     rounds
-        Bisection rounds per end (8 positions each).
+        Bisection rounds per end (8 positions each; both ends in one batch).
+    workers
+        Processes for the positions of the ends (:func:`fegear.tca.parallel.positions`).
 
     Returns
     -------
@@ -176,18 +191,19 @@ def contact_path(
     while hi < len(s) - 1 and inside[hi + 1]:
         hi += 1
     run = s[lo : hi + 1]
+    ends = ([(s[lo], s[lo - 1])] if lo > 0 else []) + (
+        [(s[hi], s[hi + 1])] if hi < len(s) - 1 else []
+    )
+    refined = _refine(tca, ends, tol_rad, rounds, workers)
+    start_limit = end_limit = "unresolved (the interval reaches past the cycle's pairs)"
     if lo > 0:
-        start, before = _refine(tca, s[lo], s[lo - 1], tol_rad, rounds)
+        start, before = refined.pop(0)
         run = [start] + run
         start_limit = before.edge or "transfer"
-    else:
-        start_limit = "unresolved (the interval reaches past the cycle's pairs)"
     if hi < len(s) - 1:
-        end, after = _refine(tca, s[hi], s[hi + 1], tol_rad, rounds)
+        end, after = refined.pop(0)
         run = run + [end]
         end_limit = after.edge or "transfer"
-    else:
-        end_limit = "unresolved (the interval reaches past the cycle's pairs)"
     phi = np.array([x.psi for x in run])
     uv1 = np.array([x.uv1 for x in run])
     uv2 = np.array([x.uv2 for x in run])
@@ -219,17 +235,19 @@ def contact_path(
     )
 
 
-def cached_contact_path(pinion, gear, assembly, options, tca: TCA, positions) -> ContactPath | None:
+def cached_contact_path(
+    pinion, gear, assembly, options, tca: TCA, positions, workers: int | None = None
+) -> ContactPath | None:
     """:func:`contact_path` of the pair, read from the artefact cache when the same pair
     (members, assembly with its errors, TCA options, the positions' angles) was traced before
-    (seed face gear ~1.8 s otherwise)."""
+    (seed face gear ~1.8 s otherwise). ``workers``: as :func:`contact_path`."""
     phi1 = np.array([p.phi1 for p in positions], dtype=float)
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
     box: dict[str, ContactPath | None] = {}
     arrays = ("phi", "gear_points", "pinion_points", "fixed_points", "gear_uv", "pinion_uv")
 
     def build(path) -> None:
-        cp = box["cp"] = contact_path(tca, positions)
+        cp = box["cp"] = contact_path(tca, positions, workers=workers)
         with open(path, "wb") as fh:
             if cp is None:
                 np.savez(fh, none=np.array(True))

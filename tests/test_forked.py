@@ -1,5 +1,6 @@
-"""Work done in a second process (:mod:`fegear.output.apart`): the pictures of a run drawn
-while its VTK files are written. What the caller gets does not depend on where it was done."""
+"""Work done in forked processes (:mod:`fegear.forked`): the pictures of a run drawn while its VTK
+files are written, parts of one computation side by side. What the caller gets does not depend
+on where it was done."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import os
 
 import pytest
 
-from fegear.output.apart import apart
+from fegear.forked import apart
 
 
 def test_work_apart_returns_what_it_returns_here(tmp_path):
@@ -46,3 +47,16 @@ def test_without_fork_the_work_runs_here_when_asked():
     wait = apart(lambda: ran.append(os.getpid()) or "here", fork=False)
     assert ran == []
     assert wait() == "here" and ran == [os.getpid()]
+
+
+def test_fork_map_keeps_the_order_and_works_here_and_apart():
+    """The first part here, the others in forked processes at the same time; results in the
+    order of the parts."""
+    from fegear.forked import fork_map
+
+    out = fork_map(lambda p: (p, os.getpid()), [10, 11, 12])
+    assert [p for p, _ in out] == [10, 11, 12]
+    pids = [pid for _, pid in out]
+    assert pids[0] == os.getpid() and os.getpid() not in pids[1:] and len(set(pids)) == 3
+    assert fork_map(lambda p: os.getpid(), [1, 2], fork=False) == [os.getpid()] * 2
+    assert fork_map(lambda p: p, []) == []
