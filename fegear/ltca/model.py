@@ -32,6 +32,7 @@ from fegear.mechanics.compliance import (
     candidate_operator,
     find_tets,
     load_operator,
+    outward_facet_normals,
     prepare_locators,
 )
 from fegear.mesh.sector import SectorMesh
@@ -242,13 +243,8 @@ def _layer_tets(mesh, facets: np.ndarray, depth: float) -> np.ndarray:
     Every tetrahedron with a vertex on a flank is added (cells overhanging a flank edge).
     """
     tri = mesh.p[:, mesh.facets[:, facets]].transpose(2, 1, 0)  # (nf, 3, 3)
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal = outward_facet_normals(mesh, facets)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    # Orient outward: away from the fourth vertex of the facet's tetrahedron.
-    t = mesh.f2t[0, facets]
-    far = mesh.p[:, mesh.t[:, t]].mean(axis=1).T
-    flip = np.sum((far - tri.mean(axis=1)) * normal, axis=1) > 0
-    normal[flip] *= -1
     w = np.array(
         [
             [1, 0, 0],

@@ -61,6 +61,7 @@ __all__ = [
     "candidate_operator",
     "body_compliance",
     "boundary_normals",
+    "outward_facet_normals",
 ]
 
 log = logging.getLogger(__name__)
@@ -733,6 +734,19 @@ class _Stiffness:
         return self._K
 
 
+def outward_facet_normals(mesh: skfem.MeshTet, facets: np.ndarray) -> np.ndarray:
+    """``(nf, 3)`` outward normals of the boundary ``facets`` of a tet mesh, each as long as its
+    facet's area: ``½ (x1 − x0) × (x2 − x0)``, turned away from the centroid of the one
+    tetrahedron that owns the facet (a boundary facet has one)."""
+    fac = np.asarray(facets, dtype=np.int64)
+    tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3, 3)
+    area_normal = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    far = mesh.p[:, mesh.t[:, mesh.f2t[0, fac]]].mean(axis=1).T  # owning tet's centroid
+    flip = np.sum((far - tri.mean(axis=1)) * area_normal, axis=1) > 0
+    area_normal[flip] *= -1.0
+    return area_normal
+
+
 def boundary_normals(mesh: skfem.MeshTet, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The P2 nodes of the boundary ``facets`` and their normals.
 
@@ -742,11 +756,7 @@ def boundary_normals(mesh: skfem.MeshTet, facets: np.ndarray) -> tuple[np.ndarra
     holding it, weighted by their areas (the normal of a smooth surface sampled by flat
     facets, to the order of the facets' size times its curvature)."""
     fac = np.asarray(facets, dtype=np.int64)
-    tri = mesh.p[:, mesh.facets[:, fac]].transpose(2, 1, 0)  # (nf, 3, 3)
-    area_normal = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    far = mesh.p[:, mesh.t[:, mesh.f2t[0, fac]]].mean(axis=1).T  # owning tet's centroid
-    flip = np.sum((far - tri.mean(axis=1)) * area_normal, axis=1) > 0
-    area_normal[flip] *= -1.0
+    area_normal = outward_facet_normals(mesh, fac)
     node = np.concatenate([mesh.facets[:, fac], mesh.p.shape[1] + mesh.f2e[:, fac]])  # (6, nf)
     s, inv = np.unique(node.ravel(), return_inverse=True)
     acc = np.zeros((s.size, 3))
