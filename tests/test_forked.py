@@ -60,3 +60,47 @@ def test_fork_map_keeps_the_order_and_works_here_and_apart():
     assert pids[0] == os.getpid() and os.getpid() not in pids[1:] and len(set(pids)) == 3
     assert fork_map(lambda p: os.getpid(), [1, 2], fork=False) == [os.getpid()] * 2
     assert fork_map(lambda p: p, []) == []
+
+
+def test_sectors_meshed_side_by_side_are_the_meshes_made_here_and_counted_here():
+    """The gear's sector meshed in a forked process while the pinion's is meshed here: the
+    same meshes (same cache entries, same arrays) as both made here, and the run's cache record
+    counts both lookups (the child's are sent back: ``fegear.store.cache.recorded``)."""
+    import pickle
+    from pathlib import Path
+
+    import numpy as np
+
+    from fegear.case_files import load_case
+    from fegear.ltca.analysis import _sector_meshes
+    from fegear.pipeline.pair import build_pair
+    from fegear.store.cache import record_cache_use
+
+    pair = build_pair(load_case(Path(__file__).resolve().parents[1] / "cases" / "fzg_spur.toml"))
+    members, sides = (pair.pinion, pair.gear), ("drive", "drive")
+    with record_cache_use() as used:
+        apart_ = _sector_meshes(members, sides, 5, 0, workers=2)
+    use = used()
+    assert sum(use.hits.values()) + sum(use.built.values()) == 2, use  # one lookup per member
+    with record_cache_use() as again:
+        here = _sector_meshes(members, sides, 5, 0, workers=1)
+    assert again().hits == {"mesh": 2} and not again().built  # what the child built is cached
+    for a, b in zip(apart_, here, strict=True):
+        assert a.path == b.path and np.array_equal(a.points, b.points)
+        assert np.array_equal(a.tets, b.tets) and a.boundaries.keys() == b.boundaries.keys()
+        assert dict(a.parameters) == dict(b.parameters)
+        c = pickle.loads(pickle.dumps(a))  # how it crossed: read-only mappings again
+        assert np.array_equal(c.points, a.points) and c.parameters == a.parameters
+        with pytest.raises(TypeError):
+            c.parameters["level"] = 1  # type: ignore[index]
+
+
+def test_nested_cache_records_each_count_their_own():
+    """A block inside another (``recorded`` inside ``record_cache_use``) leaves the outer one
+    in place however equal their counts (two empty records compare equal)."""
+    from fegear.store.cache import record_cache_use, recorded
+
+    with record_cache_use() as outer:
+        value, lookups = recorded(lambda: 7)
+    assert value == 7 and lookups.pid == os.getpid() and not lookups.hits
+    assert outer().hits == {} and outer().built == {}

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fegear.errors import InputError
+from fegear.forked import fork_map, process_count
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.model import (
     MemberModel,
@@ -25,6 +26,7 @@ from fegear.ltca.position import solve_position
 from fegear.ltca.zone import ContactZone, contact_zone
 from fegear.mesh.sector import FINE, sector_mesh
 from fegear.options import ContactOptions
+from fegear.store.cache import count_lookups, recorded
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 
@@ -161,6 +163,25 @@ def cycle_zone(
     )
 
 
+def _sector_meshes(members, sides, n_teeth: int, level: int, workers: int | None) -> list:
+    """Both members' sector meshes (:func:`fegear.mesh.sector.sector_mesh`), the pinion's here
+    and the gear's in a forked process at the same time (:func:`fegear.forked.fork_map`) when
+    two processes are allowed (``workers``): gmsh meshes on one thread (deterministic meshes),
+    so two members meshed cold take the time of the slower one. The mesh made in the other
+    process is the one made here (same code and inputs, the cache entry it writes is read back
+    the same); its cache lookups are counted as this run's (:func:`fegear.store.cache.recorded`).
+    """
+    parts = list(zip(members, sides, strict=True))
+
+    def one(part):
+        return recorded(lambda: sector_mesh(part[0], n_teeth, level, side=part[1]))
+
+    done = fork_map(one, parts, fork=process_count(workers, len(parts)) > 1)
+    for _, lookups in done:
+        count_lookups(lookups)
+    return [sm for sm, _ in done]
+
+
 def build_models(
     pinion, gear, assembly, options: LTCAOptions, zone: ContactZone | None = None
 ) -> MemberModels:
@@ -180,10 +201,7 @@ def build_models(
         zone = cycle_zone(pinion, gear, assembly, options)
     n = zone.n_teeth
     sides = (assembly.side1, assembly.side2)
-    sectors = [
-        sector_mesh(m, n, options.level, side=side)
-        for m, side in zip((pinion, gear), sides, strict=True)
-    ]
+    sectors = _sector_meshes((pinion, gear), sides, n, options.level, options.workers)
     h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
     module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
     depth = layer = fidelity_of(options.fidelity).layer_depth(h, module, options)

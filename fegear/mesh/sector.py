@@ -174,6 +174,13 @@ class SectorMesh:
     diagnostics: Mapping[str, object] = field(default_factory=dict)
     path: Path | None = None
 
+    def __reduce__(self):
+        """Pickled with plain dicts for its read-only mappings (a mesh made in a forked process
+        comes back: :func:`fegear.ltca.analysis.build_models`), read-only again when loaded."""
+        fields = (self.member, self.family, self.points, self.tets, dict(self.boundaries),
+                  dict(self.parameters), dict(self.diagnostics), self.path)  # fmt: skip
+        return (_sector_from_fields, fields)
+
     @property
     def n_teeth(self) -> int:
         return int(self.parameters["n_teeth"])
@@ -746,6 +753,13 @@ def sector_mesh(
     public["h_fine_mm"], public["h_coarse_mm"] = mesh_sizes(fr.module, level)
     return load_sector_mesh(path, member=getattr(member, "name", ""), family=fr.family,
                             parameters=public, diagnostics=diag)  # fmt: skip
+
+
+def _sector_from_fields(member, family, points, tets, boundaries, parameters, diagnostics, path):
+    """The :class:`SectorMesh` of its pickled fields (:meth:`SectorMesh.__reduce__`)."""
+    ro = MappingProxyType
+    return SectorMesh(member, family, points, tets, ro(boundaries), ro(parameters),
+                      ro(diagnostics), path)  # fmt: skip
 
 
 def _msh_arrays(path: Path) -> tuple[Array, NDArray[np.int64], dict[str, NDArray[np.int64]]]:

@@ -56,6 +56,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 
@@ -77,6 +78,9 @@ __all__ = [
     "cache_info",
     "cache_root",
     "cached_file",
+    "count_lookups",
+    "Lookups",
+    "recorded",
     "cached_record",
     "canonical",
     "check_cache_root",
@@ -90,6 +94,7 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 #: Name of the tag file at the cache root.
 CACHE_TAG = "CACHEDIR.TAG"
@@ -418,8 +423,10 @@ def record_cache_use() -> Iterator[Callable[[], CacheUse]]:
     """Count the cache lookups made in this process inside the ``with`` block.
 
     Yields a function returning the :class:`CacheUse` so far (call it after the block for the
-    whole of it). Lookups in worker processes are not seen (the artefacts of a run are looked up
-    in the main process: meshes, operators, TCA; the workers solve positions). The entries used
+    whole of it). Lookups in worker processes are not seen unless sent back (the artefacts of a
+    run are looked up in the main process: operators, TCA; the workers solve positions; the
+    sector mesh made in a forked process comes back with its lookups: :func:`recorded`,
+    :func:`count_lookups`). The entries used
     inside the block are never evicted by the cache's size cap while it runs (a run's operators
     stay however small the cap).
     """
@@ -431,7 +438,50 @@ def record_cache_use() -> Iterator[Callable[[], CacheUse]]:
             root, dict(sorted(rec.hits.items())), dict(sorted(rec.built.items()))
         )
     finally:
-        _RECORDERS.remove(rec)
+        _drop(rec)
+
+
+def _drop(rec: _Recorder) -> None:
+    """Remove ``rec`` itself from :data:`_RECORDERS` (not a recorder equal to it: two blocks
+    that have counted the same compare equal)."""
+    for i, r in enumerate(_RECORDERS):
+        if r is rec:
+            del _RECORDERS[i]
+            return
+
+
+class Lookups(NamedTuple):
+    """The cache lookups one piece of work made (:func:`recorded`), to be counted by the
+    process it was done for (:func:`count_lookups`): ``pid`` of the process that made them,
+    ``{kind: n}`` read and built, and the ``(kind, key)`` entries used."""
+
+    pid: int
+    hits: dict[str, int]
+    built: dict[str, int]
+    used: frozenset[tuple[str, str]]
+
+
+def recorded(work: Callable[[], T]) -> tuple[T, Lookups]:
+    """``(work(), lookups)``: the value and the cache lookups made while it ran here."""
+    rec = _Recorder()
+    _RECORDERS.append(rec)
+    try:
+        value = work()
+    finally:
+        _drop(rec)
+    return value, Lookups(os.getpid(), dict(rec.hits), dict(rec.built), frozenset(rec.pinned))
+
+
+def count_lookups(lookups: Lookups) -> None:
+    """Count in this process's :func:`record_cache_use` blocks the lookups a forked process made
+    for it (:func:`recorded` there; its entries are then kept by the size cap as this
+    process's own). Lookups made in this process were counted when made: nothing to add."""
+    if lookups.pid == os.getpid():
+        return
+    for rec in _RECORDERS:
+        rec.hits.update(lookups.hits)
+        rec.built.update(lookups.built)
+        rec.pinned.update(lookups.used)
 
 
 def _count(kind: str, hit: bool) -> None:
