@@ -24,6 +24,7 @@ F_SIGMA_BETA_MM = (0.0, 0.010, 0.020)
 
 
 def main(fidelity=None, out="out/helical_crowning_sweep", crowning=CROWNING_MM,
+    # the numbers of each run only (fields=False): no displacement fields, no VTK written
          misalignment=F_SIGMA_BETA_MM, n_positions=None):  # fmt: skip
     import matplotlib
 
@@ -40,7 +41,7 @@ def main(fidelity=None, out="out/helical_crowning_sweep", crowning=CROWNING_MM,
         for c in crowning:
             pair = {**case.pair, "lead_crowning_mm": [c, 0.0]}
             r = fegear.run(case.replace(pair=pair).with_errors(f_sigma_beta_mm=f),
-                           fidelity=fidelity)  # fmt: skip
+                           fidelity=fidelity, fields=False)  # fmt: skip
             results[(f, c)] = r
             load = r.summary["cylindrical"]["load"]
             kmax = load["k_h_beta_max_position"]

@@ -230,6 +230,31 @@ def test_write_writes_the_files_of_the_command_line(fzg):
     assert json.loads((cli / "summary.json").read_text())["cache"]["built"] == {}
 
 
+def test_a_run_without_fields_has_the_numbers_and_writes_the_same_files(fzg, tmp_path):
+    """``fields=False`` (a study reading numbers): no displacement field is computed, every
+    number but the fields' mesh sizes is the full run's (the fields are read from the solved
+    contact, never fed back), and ``write`` computes the fields it writes: the same files."""
+    import dataclasses
+
+    result, _, root, _ = fzg
+    case = fegear.load_case(FZG).replace(n_positions=N_FZG)
+    lean = fegear.run(case, workers=1, fields=False)
+    assert lean.run.fields_pending and not lean.run.members
+    assert not result.run.fields_pending and len(result.run.members) == 2
+    assert lean.model.mesh == {} and set(result.model.mesh) == {"pinion", "gear"}
+    assert lean.cycle == result.cycle and lean.checks == result.checks
+    bare = [[dataclasses.replace(p, members=()) for p in r.positions] for r in (lean, result)]
+    assert bare[0] == bare[1]
+    lean.write(tmp_path / "lean")
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (tmp_path / "lean", root / "api"))
+    for doc in (a, b):  # what differs between two runs of the same case: times, cache, source
+        for key in ("timings_s", "cache", "versions"):
+            doc.pop(key)
+    assert a == b
+    for f in sorted((root / "api" / "vtk").iterdir()):  # the same fields, written the same way
+        assert f.read_bytes() == (tmp_path / "lean" / "vtk" / f.name).read_bytes(), f.name
+
+
 def test_pvd_says_its_time_unit(fzg):
     _, _, root, _ = fzg
     text = (root / "api" / "cycle.pvd").read_text()

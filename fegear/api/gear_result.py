@@ -14,6 +14,7 @@ from fegear.errors import InputError
 from fegear.io.gear_case import GearCase
 from fegear.output.flank_view import plot_flank_pattern
 from fegear.output.gear_output import write_gear_outputs
+from fegear.pipeline.run import with_fields
 from fegear.results.build import build_result
 from fegear.results.model import Checks, Cycle, GearRunResult, PatternCentre, Position
 from fegear.results.summary import summary_document, summary_warnings
@@ -61,7 +62,8 @@ class GearResult:
         ``summary.json`` holds, typed; ``summary`` is its JSON document.
     run
         The full run (:class:`fegear.pipeline.run.GearRun`: contact cells, pressure fields,
-        displacement fields) for what the typed fields do not hold.
+        and the displacement fields unless the run was made with ``fields=False``) for what
+        the typed fields do not hold.
     """
 
     case: GearCase
@@ -111,7 +113,11 @@ class GearResult:
         (:mod:`fegear.store.outputs`): the files of an earlier run written there are removed
         first, and a folder with files fegear did not write is refused unless ``overwrite``
         (then its other files are kept). A run given two or more workers draws the pictures in
-        a second process while the VTK files are written. Returns the paths.
+        a second process while the VTK files are written. A run made without its displacement
+        fields (``fegear.run(..., fields=False)``) computes them here first
+        (:func:`fegear.pipeline.run.with_fields`): the files and their ``summary.json`` are
+        those of ``fegear run`` (the ``mesh`` sizes and ``timings_s`` included, which the
+        result's own :attr:`model` lacks). Returns the paths.
 
         Raises
         ------
@@ -119,8 +125,13 @@ class GearResult:
             ``folder`` cannot be written (a file, or no permission), or holds other files and
             ``overwrite`` is False.
         """
-        with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
-            return tuple(write_gear_outputs(out, self.run, self._views, self.model, self._workers))
+        target = inspect_output_folder(folder, overwrite, "folder")  # refused before any work
+        run, model = self.run, self.model
+        if run.fields_pending:
+            run = with_fields(run)
+            model = build_result(run, self._views.pattern if self._views else None)
+        with output_run(target) as out:
+            return tuple(write_gear_outputs(out, run, self._views, model, self._workers))
 
     def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:
         """Root stress of each tooth of ``member`` (``"pinion"``/``"gear"``) that can touch:

@@ -80,6 +80,7 @@ def run(
     study: Sequence[int] | None = None,
     progress: Progress | None = None,
     notify: Callable[[str], None] | None = None,
+    fields: bool = True,
 ) -> GearResult | HertzResult:
     """Run a case.
 
@@ -112,6 +113,12 @@ def run(
         Gear pairs: ``notify(text)`` with each warning of the engagement checks as soon as it is
         made, before the loaded analysis (they are in the result's ``warnings`` too; without
         ``notify`` they are logged).
+    fields
+        Gear pairs at ``fe``/``hybrid``: compute the sectors' displacement fields (the VTK
+        files; one sparse factorisation per member and process, then a solve per run). False:
+        the numbers only, for a study that reads numbers (every number of the result but the
+        ``mesh`` sizes of the fields, which stay empty); :meth:`GearResult.write` then computes
+        the fields it writes (the same ones). ``root_stress`` computes them always.
 
     Returns
     -------
@@ -163,5 +170,6 @@ def run(
         pair=pair,
         workers=workers,
         notify=notify,
+        fields=fields,
     )
     return gear_result(gear_run, flank_views(gear_run), workers)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -73,7 +74,9 @@ class GearRun:
     tca
         :class:`~fegear.tca.CycleResult` (fidelity ``"tca"``), else None.
     members
-        The two :class:`MemberField` (fidelities ``"fe"`` and ``"hybrid"``), else empty.
+        The two :class:`MemberField` (fidelities ``"fe"`` and ``"hybrid"``), else empty; empty
+        too where the run was asked for its numbers only (``fields=False``:
+        :attr:`fields_pending`, :func:`with_fields` adds them).
     seconds
         Wall time per stage.
     engagement
@@ -108,6 +111,17 @@ class GearRun:
         return None if self.fidelity == UNLOADED else fidelity_of(self.fidelity)
 
     @property
+    def fields_pending(self) -> bool:
+        """A loaded run with cell loads whose displacement fields were not computed
+        (:func:`run_gear_case` with ``fields=False``; :func:`with_fields` computes them)."""
+        return (
+            self.cycle is not None
+            and self.kind is not None
+            and self.kind.cells
+            and not self.members
+        )
+
+    @property
     def phi2(self) -> Array:
         """``(n,)`` rad, gear angle of the TCA-closed position (``ratio φ1 + TE_unloaded``)."""
         c = self.cycle if self.cycle is not None else self.tca
@@ -137,6 +151,7 @@ def run_gear_case(
     pair: GearPair | None = None,
     workers: int | None = None,
     notify: Callable[[str], None] | None = None,
+    fields: bool = True,
 ) -> GearRun:
     """Run a gear case at its (or the given) fidelity and level.
 
@@ -158,6 +173,12 @@ def run_gear_case(
     notify
         ``notify(text)``: called with each warning of the engagement checks as soon as they
         are made, before the loaded analysis (they are in ``GearRun.engagement`` too).
+    fields
+        Compute the displacement fields of the sectors (the VTK files, the stresses; one sparse
+        factorisation per member and process, then one solve per member and run). False: the
+        numbers only (every number of ``summary.json`` but the ``mesh`` sizes of the fields);
+        :func:`with_fields` adds them later. The root stress (``case.root_stress``) is always
+        computed: it is a number of the run.
 
     Raises
     ------
@@ -169,8 +190,38 @@ def run_gear_case(
     from dataclasses import replace
 
     with record_cache_use() as used:
-        run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify)
+        run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields)
     return replace(run, cache=used())
+
+
+def with_fields(run: GearRun, progress: Progress | None = None) -> GearRun:
+    """``run`` with its displacement fields (:func:`fegear.pipeline.fields.displacements`) if
+    they are pending (:attr:`GearRun.fields_pending`), else ``run`` itself: a new run, its
+    ``seconds`` and ``cache`` counting the fields' work too. What ``fields=True`` would have
+    computed, with the same models and loads: the same fields."""
+    from dataclasses import replace
+
+    if not run.fields_pending:
+        return run
+    say = progress or (lambda stage, i, n: None)
+    t0 = time.perf_counter()
+    say("displacements", None, None)
+    with record_cache_use() as used:
+        c = run.case
+        members = displacements(run.pair, run.assembly, run.cycle.models, run.cycle, run.phi2,
+                                root_stress=c.root_stress, backend=c.backend)  # fmt: skip
+    seconds = {**run.seconds, "displacements": time.perf_counter() - t0}
+    return replace(run, members=members, seconds=seconds, cache=_joined(run.cache, used()))
+
+
+def _joined(a: CacheUse | None, b: CacheUse) -> CacheUse:
+    """The lookups of ``a`` and ``b`` together."""
+    if a is None:
+        return b
+    hits, built = Counter(a.hits), Counter(a.built)
+    hits.update(b.hits)
+    built.update(b.built)
+    return CacheUse(a.root, dict(sorted(hits.items())), dict(sorted(built.items())))
 
 
 def _ellipses(case: GearCase, tca, positions) -> tuple:
@@ -179,7 +230,7 @@ def _ellipses(case: GearCase, tca, positions) -> tuple:
     return ellipses(positions, tca.asm.axis1(), T1, tca.opt.paint_mm, case.E_MPa, case.nu)
 
 
-def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> GearRun:
+def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields) -> GearRun:
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
     seconds: dict[str, float] = {}
@@ -242,25 +293,9 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify) -> Ge
         progress=lambda i, n: say("positions", i, n),
     )
     seconds["positions"] = time.perf_counter() - t0
-    models = cycle.models  # those of the grown zone if the load made it grow
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng,
                   ellipses=ell)  # fmt: skip
-    if not fidelity_of(case.fidelity).cells:  # no cell loads: no displacement fields
-        return run
-    t0 = time.perf_counter()
-    say("displacements", None, None)
-    members = displacements(
-        pair, asm, models, cycle, run.phi2, root_stress=case.root_stress, backend=case.backend
-    )
-    seconds["displacements"] = time.perf_counter() - t0
-    return GearRun(
-        case=case,
-        pair=pair,
-        assembly=asm,
-        cycle=cycle,
-        members=members,
-        seconds=seconds,
-        engagement=eng,
-        ellipses=ell,
-    )
+    if fields or case.root_stress:  # else the numbers only: the fields when written
+        return with_fields(run, say)
+    return run
