@@ -224,14 +224,15 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             ("models", f"{kind.models_text} (cached after the first run)"),
             ("positions", f"mesh positions ({kind.positions_text})"),
         ]
-        if kind.cells:
-            stages.append(("displacements", "displacement fields (one sparse solve per member)"))
     else:
         stages = [
             ("geometry", "geometry, assembly and tip clearance"),
             ("tca", "unloaded TCA over the cycle and engagement checks"),
         ]
-    stages.append(("writing", "writing outputs"))
+    writing = "writing outputs"
+    if kind is not None and kind.cells:  # the fields are computed while the pictures are drawn
+        writing = "displacement fields (one sparse solve per member) and outputs"
+    stages.append(("writing", writing))
     labels = {s: f"[{i}/{len(stages)}] {text}" for i, (s, text) in enumerate(stages, 1)}
     stage_t = {"t": t_start, "started": False}
 
@@ -261,6 +262,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         root_stress=args.root_stress,
         progress=progress,
         notify=warn,
+        fields=False,  # computed by write, beside the pictures (fegear.output.gear_output)
     )
     progress("writing", None, None)
     paths = result.write(out, overwrite=args.overwrite)

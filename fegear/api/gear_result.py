@@ -14,7 +14,6 @@ from fegear.errors import InputError
 from fegear.io.gear_case import GearCase
 from fegear.output.flank_view import plot_flank_pattern
 from fegear.output.gear_output import write_gear_outputs
-from fegear.pipeline.run import with_fields
 from fegear.results.build import build_result
 from fegear.results.model import Checks, Cycle, GearRunResult, PatternCentre, Position
 from fegear.results.summary import summary_document, summary_warnings
@@ -114,10 +113,10 @@ class GearResult:
         first, and a folder with files fegear did not write is refused unless ``overwrite``
         (then its other files are kept). A run given two or more workers draws the pictures in
         a second process while the VTK files are written. A run made without its displacement
-        fields (``fegear.run(..., fields=False)``) computes them here first
-        (:func:`fegear.pipeline.run.with_fields`): the files and their ``summary.json`` are
-        those of ``fegear run`` (the ``mesh`` sizes and ``timings_s`` included, which the
-        result's own :attr:`model` lacks). Returns the paths.
+        fields (``fegear.run(..., fields=False)``) computes them here, while its pictures are
+        drawn (:func:`fegear.output.gear_output.write_gear_outputs`): the files and their
+        ``summary.json`` are those of ``fegear run`` (the ``mesh`` sizes and ``timings_s``
+        included, which the result's own :attr:`model` lacks). Returns the paths.
 
         Raises
         ------
@@ -125,12 +124,9 @@ class GearResult:
             ``folder`` cannot be written (a file, or no permission), or holds other files and
             ``overwrite`` is False.
         """
-        target = inspect_output_folder(folder, overwrite, "folder")  # refused before any work
-        run, model = self.run, self.model
-        if run.fields_pending:
-            run = with_fields(run)
-            model = build_result(run, self._views.pattern if self._views else None)
-        with output_run(target) as out:
+        run = self.run
+        model = None if run.fields_pending else self.model  # rebuilt with the fields
+        with output_run(inspect_output_folder(folder, overwrite, "folder")) as out:
             return tuple(write_gear_outputs(out, run, self._views, model, self._workers))
 
     def root_stress(self, member: str, what: str = "tension") -> dict[int, np.ndarray]:

@@ -93,7 +93,7 @@ from fegear.output.flank_view import (
 )
 from fegear.output.gear_plots import loaded_plots, tca_plots
 from fegear.output.vtk import write_gear_vtk, write_pvd
-from fegear.pipeline.run import GearRun
+from fegear.pipeline.run import GearRun, with_fields
 from fegear.results.build import build_result
 from fegear.results.cylindrical import is_cylindrical
 from fegear.results.model import GearRunResult
@@ -153,15 +153,23 @@ def write_gear_outputs(
     not given. ``workers``: the processes the run may use (None: as the positions,
     ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
     are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`).
+    A run whose displacement fields are pending (``run.fields_pending``) gets them here
+    (:func:`fegear.pipeline.run.with_fields`) while the pictures are drawn (they show no
+    field), and ``result`` is then built from the run with its fields.
     """
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     views = views if views is not None else flank_views(run)
-    result = result if result is not None else build_result(run, views.pattern)
+    pending = run.fields_pending
+    result = result if result is not None and not pending else build_result(run, views.pattern)
     paths: list[Path] = []
     if run.cycle is not None:
-        plots = apart(lambda: loaded_plots(out, run, result), process_count(workers, 2) > 1)
+        fork = process_count(workers, 2) > 1
+        plots = apart(lambda r=run, res=result: loaded_plots(out, r, res), fork)
+        if pending:  # the fields while the pictures are drawn, then the model with them
+            run = with_fields(run)
+            result = build_result(run, views.pattern)
         paths += write_gear_vtk(out, run, views)
         paths += plots()
         if is_cylindrical(run):

@@ -486,8 +486,8 @@ def run_item(
     tmp = out / f".{item.name}.{uuid.uuid4().hex[:8]}.tmp"
     try:
         tmp.mkdir(parents=True)
-        run = run_gear_case(item.case, workers=position_workers)
-        write_gear_outputs(tmp, run)
+        run = run_gear_case(item.case, workers=position_workers, fields=False)
+        write_gear_outputs(tmp, run)  # the fields beside the pictures
         seconds = time.perf_counter() - t0
         write_json(
             tmp / MARKER,
