@@ -59,6 +59,7 @@ from fegear import __version__
 from fegear.case_files import load_case, parse_case
 from fegear.errors import BackendUnavailable, FegearError, InputError
 from fegear.io.gear_case import FIDELITIES, GEAR_KINDS, N_LEVELS, GearCase
+from fegear.output.figure import pyplot
 from fegear.output.gear_output import write_gear_outputs
 from fegear.pipeline.run import run_gear_case
 from fegear.store.cache import cache_root as _cache_root
@@ -557,7 +558,10 @@ def _clean_tmp(out: Path) -> list[str]:
 
 
 def _worker_init() -> None:  # pragma: no cover  (runs in the worker processes)
-    """Local worker: die with the sweep process (Linux), one BLAS thread per worker."""
+    """Local worker: die with the sweep process (Linux), one BLAS thread per worker, and
+    matplotlib imported once: every item draws its pictures in a process forked from this one
+    (:func:`fegear.output.gear_output.write_gear_outputs`), which then finds it imported
+    instead of importing it again (about a second per item)."""
     if sys.platform.startswith("linux"):
         try:
             import ctypes
@@ -566,6 +570,7 @@ def _worker_init() -> None:  # pragma: no cover  (runs in the worker processes)
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
         except Exception:  # noqa: BLE001  (best effort)
             pass
+    pyplot()
 
 
 def _local_pool(workers: int) -> ProcessPoolExecutor:
