@@ -1,28 +1,37 @@
-"""CalculiX (full FE contact) against fegear: the Hertz scene and FZG at two positions.
+"""CalculiX (full FE contact) against fegear: Hertz scene, FZG, face gear, spiral bevel.
 
 For each problem, CalculiX is refined along a ladder of contact element sizes (its own
 convergence shown) and set beside fegear ``hybrid`` (and ``fe``) with the same quantities:
-load shares, p_max (interior), patch semi-axes, TE / approach, wall time and peak memory.
+load shares, p_max (interior), patch semi-axes, TE / approach, wall time and peak memory, and the
+machine's 1-minute load average before each run.
 
 - **Hertz scene** (``cases/hertz_scene.toml``, quarter model): p0, a, b against closed-form Hertz;
   fegear ``hybrid`` levels 0-3 (FE of level 0).
 - **FZG** (``cases/fzg_spur.toml``, 200 N·m) at the pitch point (single pair) and at a two-pair
-  position: load shares, interior p_max, the lag and the loaded TE; fegear ``hybrid`` level 0 and
-  ``fe`` level 0.
+  position; **seed face gear** (``cases/face_gear_nominal.toml``) at two positions of its cycle
+  (:data:`FACE_GEAR_POSITIONS`); **spiral bevel** (``cases/spiral_bevel_nominal.toml``) at one
+  (:data:`SPIRAL_BEVEL_POSITIONS`): load shares, interior p_max, patch semi-axes, the lag and the
+  loaded TE; fegear ``hybrid`` level 0 and ``fe`` level 0.
 
 Every measurement runs in its own process, so the peak memory (max RSS) is its own; CalculiX with
-``OMP_NUM_THREADS = --threads``, one run at a time. fegear rows are cold (an empty cache: meshes
-and compliance operators built) and warm (the same run again).
+``OMP_NUM_THREADS = --threads``, one run at a time. fegear rows: cold (an empty cache: meshes
+and compliance operators built) and warm (the same run again); a case's later positions warm only,
+on the cache of its first.
 
 Usage::
 
-    python benchmarks/calculix_crosscheck.py [--threads 2] [--work DIR] [--hertz 0.45,0.32,...]
-        [--fzg 0.7,0.5,...] [--skip-fzg] [--skip-hertz]
+    python benchmarks/calculix_crosscheck.py [--threads 2] [--work DIR]
+        [--hertz 0.45,0.32,...] [--fzg 0.7,...] [--face-gear 2,1.4,1/2,1.4] [--spiral-bevel 1,...]
+        [--skip-hertz] [--skip-fzg] [--skip-face-gear] [--skip-spiral-bevel] [--report-only]
 
 Finds ``ccx`` (``$FEGEAR_CCX`` or the ``PATH``; says so and stops when it is missing). Writes
-``benchmarks/results/calculix.md`` and ``calculix.json``; the decks, CalculiX's files and one
-``<job>.row.json`` per finished run stay in ``--work`` (a run with a row there is not repeated:
-delete the row to measure it again).
+``benchmarks/results/calculix.md`` and ``calculix.json`` (the page from
+:func:`fegear.validation.calculix_rows.markdown`; ``docs/make_validation.py`` puts the rows in
+``docs/validation.md``). A skipped section keeps its rows (and the command that measured them)
+from the last ``calculix.json``. The decks, CalculiX's files and one ``<job>.row.json`` per
+finished run stay in ``--work`` (a run with a row there is not repeated: delete the row to
+measure it again; likewise the fegear rows in ``--work/fegear_rows``). A gear option's sizes
+may differ per position: ``2,1.4,1/2,1.4`` is the first position's ladder, then the others'.
 """
 
 from __future__ import annotations
@@ -46,6 +55,17 @@ OUT = ROOT / "benchmarks" / "results"
 FZG_TWO_PAIRS_DEG = 5.0
 HERTZ_LADDER = (0.45, 0.32, 0.24, 0.16, 0.12)
 FZG_LADDER = (0.7, 0.5, 0.35)
+#: Seed face gear: positions of its 25-position cycle (labels) picked from fegear's own loaded
+#: analysis (``hybrid`` level 0, ``fegear run cases/face_gear_nominal.toml``): position 16 (φ1 =
+#: 2.016°) has two pairs with interior patches sharing 0.53 / 0.47; no position of the cycle has a
+#: single pair loaded, position 6 (φ1 = −3.744°) is the nearest (one pair carries 0.96, its
+#: neighbour 0.04 on the pinion's tip edge).
+FACE_GEAR_POSITIONS = (("two pairs", 16), ("one pair carrying 0.96", 6))
+FACE_GEAR_LADDER = (1.0, 0.7)
+#: Spiral bevel: one position of its 13-position cycle, from its `hybrid` level-0 analysis:
+#: position 3 (φ1 = −8.077°), two pairs with interior patches sharing 0.44 / 0.56.
+SPIRAL_BEVEL_POSITIONS = (("two pairs", 3),)
+SPIRAL_BEVEL_LADDER = (1.0, 0.7)
 
 
 def measured(cmd: list[str], env: dict | None = None, cwd: Path | None = None):
@@ -94,17 +114,38 @@ print(json.dumps({"theta": p.theta, "te_unloaded": p.te_unloaded_arcsec,
 """
 
 
-def fegear_row(code: str, args: list[str]) -> dict:
-    """A fegear measurement, cold (fresh cache) then warm (the same cache)."""
+def fegear_rows(code: str, arg_lists: list[list[str]], keep: Path | None = None) -> list[dict]:
+    """fegear measurements on one fresh cache: the first cold (meshes and operators built) then
+    warm, each later one warm only (the operators do not depend on the position). With ``keep``,
+    each finished row is kept in ``keep/<hash>.json`` and not measured again."""
+    import hashlib
+
+    rows: list[dict | None] = []
+    for args in arg_lists:
+        tag = hashlib.sha1(json.dumps([code, args]).encode()).hexdigest()[:16]
+        f = None if keep is None else keep / f"{tag}.json"
+        rows.append(json.loads(f.read_text()) if f is not None and f.is_file() else None)
+    if all(r is not None for r in rows):
+        return rows
     with tempfile.TemporaryDirectory(prefix="fegear_ccx_bench_") as cache:
         env = {**os.environ, "FEGEAR_CACHE": cache, "FEGEAR_WORKERS": "1"}
-        cmd = [sys.executable, "-c", code, *args]
-        load = os.getloadavg()[0]
-        out, cold, mem = measured(cmd, env)
-        _, warm, mem_w = measured(cmd, env)
-    row = json.loads(out.strip().splitlines()[-1])
-    row.update(cold_s=cold, warm_s=warm, peak_MB=mem, peak_warm_MB=mem_w, load_before=load)
-    return row
+        for i, args in enumerate(arg_lists):
+            cmd = [sys.executable, "-c", code, *args]
+            load = os.getloadavg()[0]
+            cold = mem = None
+            if i == 0:
+                _, cold, mem = measured(cmd, env)
+            load_w = os.getloadavg()[0]
+            out, warm, mem_w = measured(cmd, env)
+            row = json.loads(out.strip().splitlines()[-1])
+            row.update(cold_s=cold, warm_s=warm, peak_MB=mem if mem is not None else mem_w,
+                       peak_warm_MB=mem_w, load_before=load if i == 0 else load_w)  # fmt: skip
+            rows[i] = row
+            if keep is not None:
+                keep.mkdir(parents=True, exist_ok=True)
+                tag = hashlib.sha1(json.dumps([code, args]).encode()).hexdigest()[:16]
+                (keep / f"{tag}.json").write_text(json.dumps(row, indent=1))
+    return rows
 
 
 # -------------------------------------------------------------------------------- CalculiX
@@ -146,11 +187,7 @@ def ccx_row(case_path: Path, work: Path, threads: int, element_mm: float,
     return row
 
 
-# --------------------------------------------------------------------------------- report
-def _pct(x: float | None) -> str:
-    return "—" if x is None else f"{100 * x:+.2f}%"
-
-
+# ------------------------------------------------------------------------------ the sections
 def hertz_rows(work: Path, threads: int, ladder) -> dict:
     from fegear.api import load_case
     from fegear.scenes.hertz_scene import hertz_reference
@@ -171,208 +208,92 @@ def hertz_rows(work: Path, threads: int, ladder) -> dict:
         out["ccx"].append(r)
         print(f"  hertz ccx {h} mm: {r.get('e_p0')}", file=sys.stderr, flush=True)
     for level in (0, 1, 2, 3):
-        r = fegear_row(FEGEAR_HERTZ, [str(level)])
+        (r,) = fegear_rows(FEGEAR_HERTZ, [[str(level)]])
         r["level"] = level
         out["fegear"].append(r)
     return out
 
 
-def fzg_rows(work: Path, threads: int, ladder) -> dict:
+def gear_positions(key: str) -> tuple[Path, list[tuple[str, float, int | None]]]:
+    """The case of gear section ``key`` and its positions ``(label, φ1 deg, cycle index)``."""
     from fegear.api import load_case
-    from fegear.pipeline.pair import build_pair
-    from fegear.validation.rows import fzg_reference, pitch_point_phi1
+    from fegear.export import position_angle
 
-    case = load_case(CASES / "fzg_spur.toml")
-    pitch = round(math.degrees(pitch_point_phi1(build_pair(case))), 3)
-    out = {"line_hertz_p0_MPa": fzg_reference(case)[0].p_H_MPa}
-    for label, phi in (("pitch point", pitch), ("two pairs", FZG_TWO_PAIRS_DEG)):
-        rows = {"phi1_deg": phi, "ccx": [], "fegear": []}
-        for h in ladder:
-            rows["ccx"].append(ccx_row(CASES / "fzg_spur.toml", work, threads, h, phi))
-        for fid, level in (("hybrid", 0), ("fe", 0)):
-            r = fegear_row(FEGEAR_GEAR, [str(CASES / "fzg_spur.toml"), str(phi), fid, str(level)])
-            r.update(fidelity=fid, level=level)
-            rows["fegear"].append(r)
+    if key == "fzg":
+        from fegear.pipeline.pair import build_pair
+        from fegear.validation.rows import pitch_point_phi1
+
+        path = CASES / "fzg_spur.toml"
+        pitch = round(math.degrees(pitch_point_phi1(build_pair(load_case(path)))), 3)
+        return path, [("pitch point", pitch, None), ("two pairs", FZG_TWO_PAIRS_DEG, None)]
+    path, picks = {"face_gear": (CASES / "face_gear_nominal.toml", FACE_GEAR_POSITIONS),
+                   "spiral_bevel": (CASES / "spiral_bevel_nominal.toml",
+                                    SPIRAL_BEVEL_POSITIONS)}[key]  # fmt: skip
+    case = load_case(path)
+    return path, [(label, round(math.degrees(position_angle(case, i)), 3), i) for label, i in picks]
+
+
+def gear_rows(key: str, work: Path, threads: int, ladders: list[list[float]]) -> dict:
+    """A gear section: per position, CalculiX along its ladder (``ladders``: one per position,
+    the last one repeated for the positions after it), then fegear ``hybrid`` and ``fe`` level
+    0 (each cold at the first position, warm at every one)."""
+    path, where = gear_positions(key)
+    out: dict = {}
+    if key == "fzg":
+        from fegear.api import load_case
+        from fegear.validation.rows import fzg_reference
+
+        out["line_hertz_p0_MPa"] = fzg_reference(load_case(path))[0].p_H_MPa
+    for i, (label, phi, index) in enumerate(where):
+        rows = {"phi1_deg": phi, "position": index, "ccx": [], "fegear": []}
+        for h in ladders[min(i, len(ladders) - 1)]:
+            r = ccx_row(path, work, threads, h, phi)
+            rows["ccx"].append(r)
+            res = r.get("result", {})
+            print(f"  {key} {label} ccx {h} mm: {r['ccx_s']:.0f} s, {r['peak_MB']:.0f} MB, "
+                  f"lag {res.get('theta_rad')}", file=sys.stderr, flush=True)  # fmt: skip
         out[label] = rows
+    for fid, level in (("hybrid", 0), ("fe", 0)):
+        args = [[str(path), str(phi), fid, str(level)] for _, phi, _ in where]
+        for (label, _, _), r in zip(where, fegear_rows(FEGEAR_GEAR, args, work / "fegear_rows"),
+                                    strict=True):  # fmt: skip
+            r.update(fidelity=fid, level=level)
+            if r.get("cold_s") is None:
+                r["cold_at"] = where[0][0]
+            out[label]["fegear"].append(r)
     return out
 
 
-def markdown(doc: dict) -> str:
-    L = ["# CalculiX cross-check", "", f"`{doc['command']}`", "",
-         f"CalculiX {doc['ccx_version']} (`{doc['ccx']}`), {doc['threads']} thread(s); fegear "
-         "in one process (`FEGEAR_WORKERS=1`). Cold: an empty cache (meshes and compliance "
-         "operators built); warm: the same run again. Peak memory: max RSS of the process. The "
-         "machine (2 cores) was shared with other work: the load average (1 min) before each "
-         "run is in `calculix.json` (`load_before`).",
-         ""]  # fmt: skip
-    if "hertz_scene" in doc:
-        h = doc["hertz_scene"]
-        ref = h["hertz"]
-        L += ["## Hertz scene (quarter model, 2000 N)", "",
-              f"Hertz: p0 {ref['p0_MPa']:.1f} MPa, a {ref['a_mm']:.4f} mm, b "
-              f"{ref['b_mm']:.4f} mm. CalculiX: p0 is the largest nodal `CPRESS` (and the "
-              "peak recovered from the nodal forces, `fegear.mechanics.patch.measure_patch`), "
-              "a and b the "
-              "semi-axes of the nodal forces' second moments; fegear `hybrid` (FE of level 0): "
-              "the recovered peak and the same second moments on its cells.", "",
-              "| solver | contact elements (mm) | elements across 2b | DOFs | p0 err | p0 err "
-              "(recovered) | a err | b err | force balance | Newton iterations | time s | "
-              "peak MB |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-        for r in h["ccx"]:
-            if "result" not in r:
-                L.append(f"| CalculiX | {r['element_mm']} | | {r['dofs']} | failed (exit "
-                         f"{r['returncode']}) | | | | | | {r['ccx_s']:.0f} | |")  # fmt: skip
-                continue
-            L.append(
-                f"| CalculiX | {r['element_mm']} | {r['elements_across_2b']:.1f} | {r['dofs']} | "
-                f"{_pct(r['e_p0'])} | {_pct(r['e_p0_recovered'])} | {_pct(r['e_a'])} | "
-                f"{_pct(r['e_b'])} | {r['result']['balance']:.6f} | {r.get('iterations', '')} | "
-                f"{r['ccx_s']:.1f} | {r['peak_MB']:.0f} |"
-            )
-        for r in h["fegear"]:
-            L.append(
-                f"| fegear hybrid level {r['level']} | | | {r['dofs']} | {_pct(r['e_p0'])} | | "
-                f"{_pct(r['e_a'])} | {_pct(r['e_b'])} | | | {r['cold_s']:.1f} cold, "
-                f"{r['warm_s']:.1f} warm | {r['peak_MB']:.0f} |"
-            )
-        L.append("")
-    if "fzg" in doc:
-        L += ["## FZG type C, 200 N·m on the gear", "",
-              "Load share: the pair's torque on the gear axis over T2. p_max: the largest "
-              "pressure away from the flank borders (fegear's rule, `fegear.ltca.edges`; — "
-              "where none is reported), in brackets the largest overall. Lag θ: the gear's "
-              "elastic rotation (µrad); loaded TE = unloaded TE − θ.", ""]  # fmt: skip
-        L += [f"ISO 6336-2 line Hertz at the pitch point: p_H {doc['fzg']['line_hertz_p0_MPa']:.0f}"
-              " MPa.", ""]  # fmt: skip
-        for label, rows in doc["fzg"].items():
-            if not isinstance(rows, dict):
-                continue
-            L += [f"### {label} (φ1 = {rows['phi1_deg']}°)", "",
-                  "| solver | contact elements (mm) | DOFs | load shares (k, j): share | "
-                  "p_max interior (overall) MPa | semi-minor mm | lag µrad | loaded TE arcsec | "
-                  "time s | peak MB |",
-                  "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-            for r in rows["ccx"]:
-                if "result" not in r:
-                    L.append(f"| CalculiX | {r['element_mm']} | {r['dofs']} | failed (exit "
-                             f"{r['returncode']}) | | | | | {r['ccx_s']:.0f} | |")  # fmt: skip
-                    continue
-                res = r["result"]
-                prs = res["pairs"]
-                shares = ", ".join(f"({p['k']}, {p['j']}): {p['load_share']:.4f}" for p in prs)
-                pm = ", ".join(
-                    ("—" if p["p_interior_MPa"] is None else f"{p['p_interior_MPa']:.0f}")
-                    + f" ({p['p_max_MPa']:.0f})" for p in prs
-                )  # fmt: skip
-                b = ", ".join(f"{p['semi_minor_mm']:.3f}" for p in prs)
-                L.append(
-                    f"| CalculiX | {r['element_mm']} | {r['dofs']} | {shares} | {pm} | {b} | "
-                    f"{1e6 * res['theta_rad']:.1f} | {res['te_loaded_arcsec']:.2f} | "
-                    f"{r['ccx_s']:.1f} (+{r['export_s']:.0f} export) | {r['peak_MB']:.0f} |"
-                )
-            for r in rows["fegear"]:
-                prs = r["pairs"]
-                shares = ", ".join(f"({p['k']}, {p['j']}): {p['share']:.4f}" for p in prs)
-                pm = ", ".join(
-                    ("—" if p["p_interior"] is None else f"{p['p_interior']:.0f}")
-                    + f" ({p['p_max']:.0f})" for p in prs
-                )  # fmt: skip
-                b = ", ".join(f"{p['b']:.3f}" for p in prs)
-                L.append(
-                    f"| fegear {r['fidelity']} level {r['level']} | | | {shares} | {pm} | {b} | "
-                    f"{1e6 * r['theta']:.1f} | {r['te_loaded']:.2f} | {r['cold_s']:.1f} cold, "
-                    f"{r['warm_s']:.1f} warm | {r['peak_MB']:.0f} |"
-                )
-            L.append("")
-    L += summary(doc)
-    return "\n".join(L) + "\n"
-
-
-def _settled(rows: list[dict], keys, tol: float) -> dict | None:
-    """The first of ``rows`` (coarse to fine) from which on every row is within ``tol`` in
-    every ``keys`` (a coarse row within it by chance, with a finer one outside, does not
-    count)."""
-    for i, r in enumerate(rows):
-        if all(abs(q[k]) <= tol for q in rows[i:] for k in keys):
-            return r
-    return None
-
-
-def _shares(pairs: list[dict]) -> dict:
-    return {(p["k"], p["j"]): p["load_share"] for p in pairs}
-
-
-def _dev(ref: dict, shares: dict) -> float:
-    """Largest difference of two sets of load shares (a pair missing from one: share 0)."""
-    return max(abs(ref.get(k, 0.0) - shares.get(k, 0.0)) for k in set(ref) | set(shares))
-
-
-def summary(doc: dict) -> list[str]:
-    """The comparisons at equal accuracy, computed from the rows."""
-    L = ["## At equal accuracy", ""]
-    if "hertz_scene" in doc:
-        h = doc["hertz_scene"]
-        ok = [r for r in h["ccx"] if "result" in r]
-        for what, keys, tol in (
-            ("p0 within 1 % from this size on", ("e_p0",), 0.01),
-            ("p0, a and b within 2 % from this size on", ("e_p0", "e_a", "e_b"), 0.02),
-        ):
-            cc = _settled(sorted(ok, key=lambda r: -r["element_mm"]), keys, tol)
-            ff = _settled(sorted(h["fegear"], key=lambda r: r["level"]), keys, tol)
-            if cc and ff:
-                L.append(f"- Hertz scene, {what}: CalculiX {cc['element_mm']} mm in "
-                         f"{cc['ccx_s']:.0f} s and {cc['peak_MB']:.0f} MB; fegear hybrid level "
-                         f"{ff['level']} in {ff['cold_s']:.1f} s cold ({ff['warm_s']:.1f} s "
-                         f"warm) and {ff['peak_MB']:.0f} MB: {cc['ccx_s'] / ff['cold_s']:.0f}x "
-                         f"the cold time.")  # fmt: skip
-            elif ff and ok:
-                fin = min(ok, key=lambda r: r["element_mm"])
-                errs = ", ".join(f"{k[2:]} {_pct(fin[k])}" for k in keys)
-                L.append(f"- Hertz scene, {what}: not reached by CalculiX within its ladder (at "
-                         f"{fin['element_mm']} mm, {fin['ccx_s']:.0f} s: {errs}); fegear hybrid "
-                         f"level {ff['level']}: {ff['cold_s']:.1f} s cold.")  # fmt: skip
-    for label, rows in doc.get("fzg", {}).items():
-        if not isinstance(rows, dict):
-            continue
-        ok = sorted((r for r in rows["ccx"] if "result" in r), key=lambda r: -r["element_mm"])
-        if not ok:
-            continue
-        fin = ok[-1]["result"]
-        ref = _shares(fin["pairs"])
-
-        step = [f"{r['element_mm']} mm: {_dev(ref, _shares(r['result']['pairs'])):.4f}"
-                for r in ok[:-1]]  # fmt: skip
-        L.append(f"- FZG {label}: CalculiX's load shares against its finest size "
-                 f"({ok[-1]['element_mm']} mm): " + (", ".join(step) or "one size only")
-                 + f"; its lag {1e6 * fin['theta_rad']:.1f} µrad.")  # fmt: skip
-        for r in rows["fegear"]:
-            sh = {(p["k"], p["j"]): p["share"] for p in r["pairs"]}
-            lag = 100 * (r["theta"] / fin["theta_rad"] - 1)
-            L.append(f"  fegear {r['fidelity']} level {r['level']}: load shares within "
-                     f"{_dev(ref, sh):.4f}, lag {lag:+.1f} %, in "
-                     f"{r['cold_s']:.1f} s cold ({r['warm_s']:.1f} s warm), {r['peak_MB']:.0f} "
-                     f"MB; CalculiX at {ok[-1]['element_mm']} mm: {ok[-1]['ccx_s']:.0f} s, "
-                     f"{ok[-1]['peak_MB']:.0f} MB ({ok[-1]['ccx_s'] / r['cold_s']:.0f}x the "
-                     f"cold time).")  # fmt: skip
-    return L + [""]
+#: Sections of ``calculix.json``: key -> (option, default ladder).
+SECTIONS = {"hertz_scene": ("hertz", HERTZ_LADDER), "fzg": ("fzg", FZG_LADDER),
+            "face_gear": ("face-gear", FACE_GEAR_LADDER),
+            "spiral_bevel": ("spiral-bevel", SPIRAL_BEVEL_LADDER)}  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:
+    from fegear.validation.calculix_rows import markdown
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--work", default="ccx_work", help="decks and CalculiX files")
-    ap.add_argument("--hertz", help="comma-separated element sizes (mm)")
-    ap.add_argument("--fzg", help="comma-separated element sizes (mm)")
-    ap.add_argument("--skip-hertz", action="store_true")
-    ap.add_argument("--skip-fzg", action="store_true")
+    for opt, ladder in SECTIONS.values():
+        sizes = ",".join(map(str, ladder))
+        ap.add_argument(f"--{opt}", help=f"contact element sizes (mm), default {sizes}; gears: "
+                        "'/' between the ladders of the positions")  # fmt: skip
+        ap.add_argument(f"--skip-{opt}", action="store_true",
+                        help="do not run it (its rows are kept from --out's .json)")  # fmt: skip
     ap.add_argument("--out", default=str(OUT / "calculix"), help="report path without extension")
     ap.add_argument("--report-only", action="store_true",
                     help="rewrite the .md from the .json of the last run (no runs)")  # fmt: skip
     args = ap.parse_args(argv)
     out = Path(args.out)
+    old = (
+        json.loads(out.with_suffix(".json").read_text())
+        if out.with_suffix(".json").is_file()
+        else {}
+    )
     if args.report_only:
-        text = markdown(json.loads(out.with_suffix(".json").read_text()))
+        text = markdown(old)
         out.with_suffix(".md").write_text(text)
         print(text)
         return 0
@@ -395,12 +316,21 @@ def main(argv: list[str] | None = None) -> int:
     cmd = " ".join(["python benchmarks/calculix_crosscheck.py", *given])
     doc = {"command": cmd, "ccx": exe, "ccx_version": version.split()[-1] if version else "?",
            "threads": args.threads}  # fmt: skip
-    if not args.skip_hertz:
-        ladder = [float(x) for x in args.hertz.split(",")] if args.hertz else HERTZ_LADDER
-        doc["hertz_scene"] = hertz_rows(work, args.threads, ladder)
-    if not args.skip_fzg:
-        ladder = [float(x) for x in args.fzg.split(",")] if args.fzg else FZG_LADDER
-        doc["fzg"] = fzg_rows(work, args.threads, ladder)
+    for key, (opt, default) in SECTIONS.items():
+        attr = opt.replace("-", "_")
+        if getattr(args, f"skip_{attr}"):
+            if key in old:  # kept from the last run, with the command that measured it
+                doc[key] = old[key]
+                doc[key].setdefault("command", old.get("command"))
+            continue
+        sizes = getattr(args, attr)
+        ladders = ([[float(x) for x in part.split(",")] for part in sizes.split("/")] if sizes
+                   else [list(default)])  # fmt: skip
+        sec = hertz_rows(work, args.threads, ladders[0]) if key == "hertz_scene" else gear_rows(
+            key, work, args.threads, ladders)  # fmt: skip
+        sec["command"] = cmd
+        doc[key] = sec
+        out.with_suffix(".json").write_text(json.dumps(doc, indent=1))  # kept if a later fails
     out.with_suffix(".json").write_text(json.dumps(doc, indent=1))
     text = markdown(doc)
     out.with_suffix(".md").write_text(text)

@@ -13,6 +13,8 @@ helical pairs of :mod:`fegear.validation.cylindrical_rows` (contact ratios, stif
 Hertz, KHβ under misalignment, root stress with Yβ). It takes
 tens of minutes on 2 cores with an empty cache (the page states the time it took). The rows are
 kept in ``docs/validation.json``: naming sections reruns only those and keeps the others' rows.
+The section against CalculiX is rendered from ``benchmarks/results/calculix.json``
+(``python benchmarks/calculix_crosscheck.py`` measures it; this script does not run ``ccx``).
 """
 
 from __future__ import annotations
@@ -34,6 +36,9 @@ from fegear.validation import rows as V
 HERE = Path(__file__).resolve().parent
 PAGE = HERE / "validation.md"
 DATA = HERE / "validation.json"
+#: The CalculiX cross-check's rows (``python benchmarks/calculix_crosscheck.py``: hours of
+#: ``ccx``, not rerun by this script; the page's section is rendered from them).
+CALCULIX = HERE.parent / "benchmarks" / "results" / "calculix.json"
 SECTIONS = ("hertz", "fzg", "bevel", "trend", "root", "cylindrical")
 #: (fidelity, level) of the FZG pitch-point runs.
 FZG_RUNS = (("hybrid", 0), ("hybrid", 1), ("hybrid", 2), ("fe", 0), ("fe", 1), ("fe", 2),
@@ -257,8 +262,19 @@ against the load; `python docs/papers/make_spiral_bevel_multipair.py`).
 
 """
     PAGE.write_text(
-        head + table(rows) + "\n\n## Rows\n\n" + details(rows).rstrip() + "\n", encoding="utf-8"
-    )
+        head + table(rows) + "\n\n" + calculix_section() + "\n## Rows\n\n"
+        + details(rows).rstrip() + "\n",
+        encoding="utf-8",
+    )  # fmt: skip
+
+
+def calculix_section() -> str:
+    """The CalculiX rows, rendered from :data:`CALCULIX` (none when it is missing)."""
+    from fegear.validation.calculix_rows import validation_section
+
+    if not CALCULIX.is_file():
+        return ""
+    return validation_section(json.loads(CALCULIX.read_text(encoding="utf-8")))
 
 
 def main(argv: list[str]) -> None:

@@ -32,10 +32,17 @@ __all__ = [
     "read_results",
     "run_ccx",
     "DEFAULT_GEAR_ELEMENT_MM",
+    "DEFAULT_HERTZ_LEVEL",
 ]
 
 #: Default contact element size of a gear deck (mm).
 DEFAULT_GEAR_ELEMENT_MM = 0.5
+#: Default Hertz-scene level of a deck's contact elements (twice the cell size of that level:
+#: 0.239 mm at level 1). Measured on 2 cores (``benchmarks/results/calculix.md``): the coarsest
+#: level from which on CalculiX's p0 stays within 1 % of Hertz (−0.82 %, 146 s, 202 MB); its
+#: semi-minor axis from the nodal forces reads 16 % long there (7 % at level 2, 0.159 mm, 291 s;
+#: 3.4 % at level 3, 0.119 mm, 757 s and 731 MB).
+DEFAULT_HERTZ_LEVEL = 1
 
 
 def position_angle(case, index: int) -> float:
@@ -68,15 +75,18 @@ def export_ccx(
         A :class:`~fegear.scenes.hertz_case.HertzCase` (one deck) or a
         :class:`~fegear.io.gear_case.GearCase` (one deck per pinion angle of ``phi1``).
     element_mm
-        Contact element size (mm). Default: the Hertz scene's level (twice its cell size, as
-        fegear meshes it); :data:`DEFAULT_GEAR_ELEMENT_MM` for gears.
+        Contact element size (mm). Default: the Hertz scene, twice the cell size of ``level``
+        (as fegear meshes that level); gears, :data:`DEFAULT_GEAR_ELEMENT_MM`.
     phi1
         Gear pairs: pinion angles (rad; :func:`position_angle` of a cycle index).
     reach_mm
         Gear pairs: :func:`fegear.export.gear_deck.gear_deck`'s reach (default
         :data:`~fegear.export.gear_deck.DEFAULT_REACH_MM`).
     level
-        Gear pairs: sector mesh level away from the contact (default: the case's).
+        Gear pairs: sector mesh level away from the contact (default: the case's). The Hertz
+        scene: the level whose element size the contact gets when ``element_mm`` is not given
+        (default :data:`DEFAULT_HERTZ_LEVEL`, not the case's level: level 3, the case's, takes
+        CalculiX 12 minutes).
     """
     # local: the scene and the decks pull scipy, scikit-fem and meshio; the `fegear` command's
     # parser imports this package
@@ -94,8 +104,13 @@ def export_ccx(
         if phi1:
             raise InputError("positions", list(phi1), "none for the Hertz scene")
         if element_mm is None:
+            lv = DEFAULT_HERTZ_LEVEL if level is None else level
+            if not (isinstance(lv, int) and 0 <= lv < len(CELLS_ACROSS_MINOR)):
+                raise InputError(
+                    "level", lv, f"a Hertz-scene level 0..{len(CELLS_ACROSS_MINOR) - 1}"
+                )
             b = hertz_reference(case.scene).b_mm
-            element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[case.level]
+            element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[lv]
         return [hertz_deck(case.scene, element_mm, name=f"{case.name}_{element_mm:.3g}mm")
                 .write(out)]  # fmt: skip
     from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck  # local: as above

@@ -33,11 +33,12 @@ def add_parser(sub) -> None:
                    "cycle (the positions of `fegear run`, 0..n_positions-1)")  # fmt: skip
     e.add_argument("--phi1-deg", help="gear pairs: comma-separated pinion angles (deg)")
     e.add_argument("--element-mm", type=float, help="contact element size in mm (default: "
-                   "the Hertz scene's level; 0.5 for gears)")  # fmt: skip
+                   "0.5 for gears; the Hertz scene: twice the cell size of --level)")  # fmt: skip
     e.add_argument("--reach-mm", type=float, help="gear pairs: pairs within this separation "
                    "get contact pairs and refined elements (default 0.03)")  # fmt: skip
     e.add_argument("--level", type=int, help="gear pairs: sector mesh level away from the "
-                   "contact (default: the case's)")  # fmt: skip
+                   "contact (default: the case's); the Hertz scene: the level whose element size "
+                   "the contact gets (default 1: 0.24 mm, ~2.5 min of ccx on 2 cores)")  # fmt: skip
     e.add_argument("--out", default="ccx", help="output folder (default: ./ccx)")
     e.add_argument("--run", action="store_true", help="run ccx on each deck and read it back")
     e.add_argument("--threads", type=int, default=1, help="OMP_NUM_THREADS of ccx (default 1)")
