@@ -324,8 +324,8 @@ def main(argv: list[str] | None = None) -> int:
                 doc[key].setdefault("command", old.get("command"))
             continue
         sizes = getattr(args, attr)
-        ladders = ([[float(x) for x in part.split(",")] for part in sizes.split("/")] if sizes
-                   else [list(default)])  # fmt: skip
+        ladders = ([[float(x) for x in part.split(",") if x.strip()] for part in sizes.split("/")]
+                   if sizes else [list(default)])  # fmt: skip
         sec = hertz_rows(work, args.threads, ladders[0]) if key == "hertz_scene" else gear_rows(
             key, work, args.threads, ladders)  # fmt: skip
         sec["command"] = cmd

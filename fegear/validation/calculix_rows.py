@@ -50,6 +50,11 @@ def _f(x: float | None, fmt: str) -> str:
     return "—" if x is None else format(x, fmt)
 
 
+def _ab(a: float, b: float) -> str:
+    """Semi-axes ``a × b`` (— where the patch is not resolved: no width)."""
+    return "—" if not b else f"{a:.2f} × {b:.3f}"
+
+
 def _load(r: Mapping) -> str:
     return _f(r.get("load_before"), ".2f")
 
@@ -88,6 +93,13 @@ def _ccx_interior(r: Mapping) -> dict:
 def _loaded(shares: Mapping, floor: float = 0.05) -> int:
     """Pairs carrying more than ``floor`` of the torque."""
     return sum(1 for s in shares.values() if s > floor)
+
+
+def not_run(section: Mapping, label: str) -> str:
+    """Why a position has no CalculiX row: the cost of the case's runs at its other positions."""
+    runs = [f"{r['element_mm']} mm at {lab}: {r['ccx_s']:.0f} s, {r['peak_MB']:.0f} MB"
+            for lab, rows in positions(section) if lab != label for r in _ccx_ok(rows)]  # fmt: skip
+    return "CalculiX not run here (the time it takes: " + ("; ".join(runs) or "—") + ")"
 
 
 def ccx_movement(rows: Mapping) -> dict | None:
@@ -197,7 +209,7 @@ def _gear_table(rows: Mapping) -> list[str]:
         res, prs = r["result"], r["result"]["pairs"]
         shares = ", ".join(f"({p['k']}, {p['j']}): {p['load_share']:.4f}" for p in prs)
         pm = ", ".join(f"{_f(p['p_interior_MPa'], '.0f')} ({p['p_max_MPa']:.0f})" for p in prs)
-        ab = ", ".join(f"{p['semi_major_mm']:.2f} × {p['semi_minor_mm']:.3f}" for p in prs)
+        ab = ", ".join(_ab(p["semi_major_mm"], p["semi_minor_mm"]) for p in prs)
         L.append(
             f"| CalculiX | {r['element_mm']} | {r['dofs']} | {shares} | {pm} | {ab} | "
             f"{1e6 * res['theta_rad']:.2f} | {res['te_loaded_arcsec']:.3f} | "
@@ -207,7 +219,7 @@ def _gear_table(rows: Mapping) -> list[str]:
         prs = r["pairs"]
         shares = ", ".join(f"({p['k']}, {p['j']}): {p['share']:.4f}" for p in prs)
         pm = ", ".join(f"{_f(p['p_interior'], '.0f')} ({p['p_max']:.0f})" for p in prs)
-        ab = ", ".join(f"{p['a']:.2f} × {p['b']:.3f}" for p in prs)
+        ab = ", ".join(_ab(p["a"], p["b"]) for p in prs)
         L.append(
             f"| fegear {r['fidelity']} level {r['level']} | | | {shares} | {pm} | {ab} | "
             f"{1e6 * r['theta']:.2f} | {r['te_loaded']:.3f} | {_time(r)} | {r['peak_MB']:.0f} | "
@@ -298,7 +310,7 @@ def summary(doc: Mapping) -> list[str]:
         for label, rows in positions(doc.get(key, {})):
             ok = _ccx_ok(rows)
             if not ok:
-                L.append(f"- {title}, {label}: no CalculiX run finished.")
+                L.append(f"- {title}, {label}: {not_run(doc[key], label)}.")
                 continue
             fin = ok[-1]
             mv = ccx_movement(rows)
@@ -357,6 +369,24 @@ def criteria(doc: Mapping) -> list[dict]:
     return out
 
 
+def _ccx_line(row: str, fin: Mapping, mv: Mapping | None) -> str:
+    """The validation table's line of CalculiX's finest size (its last step's change)."""
+    prs = fin["result"]["pairs"]
+    moved = (lambda x: "") if mv is None else (lambda x: f" ({_pct(x)})")
+    sh = ", ".join(f"({p['k']}, {p['j']}) {p['load_share']:.4f}" for p in prs)
+    if mv is not None:
+        sh += f" (±{mv['shares']:.4f})"
+    pm = ", ".join(
+        _f(p["p_interior_MPa"], ".0f")
+        + ("" if mv is None else moved(mv["p_interior"].get((p["k"], p["j"]))))
+        for p in prs
+    )  # fmt: skip
+    ab = ", ".join(_ab(p["semi_major_mm"], p["semi_minor_mm"]) for p in prs)
+    te = f"{fin['result']['te_loaded_arcsec']:.3f}" + ("" if mv is None else moved(mv["te"]))
+    return (f"| {row} | CalculiX {fin['element_mm']} mm | {sh} | {pm} | {ab} | {te} | "
+            f"{fin['ccx_s']:.0f} s | {fin['peak_MB']:.0f} |")  # fmt: skip
+
+
 def validation_section(doc: Mapping) -> str:
     """The section of ``docs/validation.md``: per row, CalculiX's finest size beside fegear
     ``hybrid`` and ``fe`` level 0, and the acceptance checks with CalculiX's own movement."""
@@ -390,35 +420,20 @@ def validation_section(doc: Mapping) -> str:
     for key, title in GEAR_SECTIONS.items():
         for label, rows in positions(doc.get(key, {})):
             ok = _ccx_ok(rows)
-            if not ok:
-                continue
-            fin, mv = ok[-1], ccx_movement(rows)
-            prs = fin["result"]["pairs"]
-            moved = (lambda x: "") if mv is None else (lambda x: f" ({_pct(x)})")
-            sh = ", ".join(f"({p['k']}, {p['j']}) {p['load_share']:.4f}" for p in prs)
-            if mv is not None:
-                sh += f" (±{mv['shares']:.4f})"
-            pm = ", ".join(
-                _f(p["p_interior_MPa"], ".0f")
-                + ("" if mv is None else moved(mv["p_interior"].get((p["k"], p["j"]))))
-                for p in prs
-            )  # fmt: skip
-            ab = ", ".join(f"{p['semi_major_mm']:.2f} × {p['semi_minor_mm']:.3f}" for p in prs)
-            te = f"{fin['result']['te_loaded_arcsec']:.3f}" + (
-                "" if mv is None else moved(mv["te"])
-            )
             row = f"{title}, {label} (φ1 = {rows['phi1_deg']}°)"
-            L.append(f"| {row} | CalculiX {fin['element_mm']} mm | {sh} | {pm} | {ab} | {te} | "
-                     f"{fin['ccx_s']:.0f} s | {fin['peak_MB']:.0f} |")  # fmt: skip
+            if not ok:
+                L.append(f"| {row} | {not_run(doc[key], label)} | | | | | | |")
+            else:
+                L.append(_ccx_line(row, ok[-1], ccx_movement(rows)))
             for r in rows["fegear"]:
                 fp = r["pairs"]
-                eq = equal_accuracy(rows, r)
+                eq = equal_accuracy(rows, r) if ok else {"ratio": None}
                 ratio = "" if eq["ratio"] is None else f"; CalculiX {eq['ratio']:.0f}x"
                 L.append(
                     f"| | fegear {r['fidelity']} {r['level']} | "
                     + ", ".join(f"({p['k']}, {p['j']}) {p['share']:.4f}" for p in fp)
                     + " | " + ", ".join(_f(p["p_interior"], ".0f") for p in fp)
-                    + " | " + ", ".join(f"{p['a']:.2f} × {p['b']:.3f}" for p in fp)
+                    + " | " + ", ".join(_ab(p['a'], p['b']) for p in fp)
                     + f" | {r['te_loaded']:.3f} | {_time(r, ' s')}{ratio} | {r['peak_MB']:.0f} |"
                 )  # fmt: skip
     L += ["", "Time ratio: CalculiX's time at the coarsest size from which on its load shares "
