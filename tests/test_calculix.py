@@ -186,6 +186,38 @@ def test_dat_reader_reads_the_last_contact_statistics(tmp_path):
     assert d["RP"][6508][2] == pytest.approx(-0.0149)
 
 
+def test_dat_reader_reads_a_pair_out_of_contact(tmp_path):
+    """A pair out of contact: CalculiX 2.20 writes zero force and area and NaN for its centre,
+    normal and normal force; it reads as a normal force of 0, and the next pair's block stays
+    its own."""
+    nan = "             NaN           NaN           NaN"
+    empty = (
+        "\n statistics for slave set S_A, master set S_B and time  0.2E+01\n\n"
+        "   total surface force (fx,fy,fz) and moment about the origin (mx,my,mz)\n\n"
+        "    0.000000E+00  0.000000E+00  0.000000E+00  0.000000E+00  0.000000E+00  0.000000E+00"
+        f"\n\n   center of gravity and mean normal\n\n{nan}{nan}\n\n"
+        f"   moment about the center of gravity(mx,my,mz)\n\n{nan}\n\n"
+        "   area,  normal force (+ = tension) and shear force (size)\n\n"
+        "    0.000000E+00           NaN           NaN\n"
+    )
+    loaded = (
+        "\n statistics for slave set S_C, master set S_D and time  0.2E+01\n\n"
+        "   total surface force (fx,fy,fz) and moment about the origin (mx,my,mz)\n\n"
+        "   -4.0E+01 -4.2E+03  2.0E+03 -1.0E+04 -1.0E+06 -2.1E+06\n\n"
+        "   center of gravity and mean normal\n\n"
+        "    5.0E+02 -5.0E+00 -1.3E-01  8.4E-03  9.0E-01 -4.2E-01\n\n"
+        "   moment about the center of gravity(mx,my,mz)\n\n"
+        "    6.8E+02  1.1E+03  4.7E+03\n\n"
+        "   area,  normal force (+ = tension) and shear force (size)\n\n"
+        "    5.5E+00 -4.7E+03  1.9E+01\n"
+    )
+    (tmp_path / "j.dat").write_text(empty + loaded)
+    stats, _ = read_dat(tmp_path / "j.dat")
+    assert stats[("S_A", "S_B")]["normal"] == 0.0 and stats[("S_A", "S_B")]["area"] == 0.0
+    assert stats[("S_C", "S_D")]["normal"] == -4700.0
+    assert stats[("S_C", "S_D")]["moment"][2] == -2.1e6
+
+
 @needs_ccx
 def test_hertz_scene_calculix_against_hertz(tmp_path):
     """The coarsest Hertz deck run by CalculiX: the contact force balances the load, and the

@@ -159,24 +159,33 @@ class CcxResult:
 
 
 _FLOAT = r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?"
+#: A number of a contact statistics block: CalculiX 2.20 writes ``NaN`` for the centre, normal
+#: and normal force of a pair out of contact (zero force, zero area).
+_STAT = rf"(?:{_FLOAT}|NaN)"
 
 
 def read_dat(path: str | Path) -> tuple[dict[tuple[str, str], dict[str, Array]], dict]:
     """The last-time blocks of a ``.dat``: ``({(slave, master): {"force", "moment", "area",
-    "normal"}}, {set: {node: (3,) displacement}})`` (names upper case, as CalculiX writes them)."""
+    "normal"}}, {set: {node: (3,) displacement}})`` (names upper case, as CalculiX writes them).
+    A pair out of contact (zero area: CalculiX writes ``NaN`` for its normal force) reads as a
+    normal force of 0."""
     text = Path(path).read_text(encoding="ascii", errors="replace")
     stats: dict[tuple[str, str], dict[str, Array]] = {}
     pat = re.compile(
         r"statistics for slave set (\S+), master set (\S+) and time\s+(\S+)\s+"
         r"total surface force \(fx,fy,fz\) and moment about the origin\s*\(mx,my,mz\)\s+"
-        rf"((?:{_FLOAT}\s+){{6}})"
-        r".*?area,\s+normal force \(\+ = tension\) and shear force \(size\)\s+"
-        rf"((?:{_FLOAT}\s+){{3}})",
+        rf"((?:{_STAT}\s+){{6}})"
+        # within this block only (a block of a pair out of contact must not reach the next)
+        r"(?:(?!statistics for slave set).)*?"
+        r"area,\s+normal force \(\+ = tension\) and shear force \(size\)\s+"
+        rf"((?:{_STAT}\s+){{3}})",
         re.S,
     )
     for m in pat.finditer(text):
         v = np.array(m.group(4).split(), dtype=float)
         a = np.array(m.group(5).split(), dtype=float)
+        if a[0] == 0.0:  # out of contact: no area, NaN normal force
+            a = np.where(np.isfinite(a), a, 0.0)
         stats[(m.group(1), m.group(2))] = {
             "time": float(m.group(3)),
             "force": v[:3],

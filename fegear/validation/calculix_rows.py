@@ -55,6 +55,11 @@ def _ab(a: float, b: float) -> str:
     return "—" if not b else f"{a:.2f} × {b:.3f}"
 
 
+def _timing(r: Mapping) -> str:
+    """A note on how a run's time was taken, when not by the benchmark itself."""
+    return f" ({r['timing']})" if r.get("timing") else ""
+
+
 def _load(r: Mapping) -> str:
     return _f(r.get("load_before"), ".2f")
 
@@ -97,7 +102,7 @@ def _loaded(shares: Mapping, floor: float = 0.05) -> int:
 
 def not_run(section: Mapping, label: str) -> str:
     """Why a position has no CalculiX row: the cost of the case's runs at its other positions."""
-    runs = [f"{r['element_mm']} mm at {lab}: {r['ccx_s']:.0f} s, {r['peak_MB']:.0f} MB"
+    runs = [f"{r['element_mm']} mm at {lab}: {r['ccx_s']:.0f} s, {_f(r['peak_MB'], '.0f')} MB"
             for lab, rows in positions(section) if lab != label for r in _ccx_ok(rows)]  # fmt: skip
     return "CalculiX not run here (the time it takes: " + ("; ".join(runs) or "—") + ")"
 
@@ -179,13 +184,13 @@ def _hertz_md(h: Mapping) -> list[str]:
             f"| CalculiX | {r['element_mm']} | {r['elements_across_2b']:.1f} | {r['dofs']} | "
             f"{_pct(r['e_p0'])} | {_pct(r['e_p0_recovered'])} | {_pct(r['e_a'])} | "
             f"{_pct(r['e_b'])} | {r['result']['balance']:.6f} | {r.get('iterations', '')} | "
-            f"{r['ccx_s']:.1f} | {r['peak_MB']:.0f} | {_load(r)} |"
+            f"{r['ccx_s']:.1f} | {_f(r['peak_MB'], '.0f')} | {_load(r)} |"
         )
     for r in h["fegear"]:
         L.append(
             f"| fegear hybrid level {r['level']} | | | {r['dofs']} | {_pct(r['e_p0'])} | | "
             f"{_pct(r['e_a'])} | {_pct(r['e_b'])} | | | {r['cold_s']:.1f} cold, "
-            f"{r['warm_s']:.1f} warm | {r['peak_MB']:.0f} | {_load(r)} |"
+            f"{r['warm_s']:.1f} warm | {_f(r['peak_MB'], '.0f')} | {_load(r)} |"
         )
     return L + [""]
 
@@ -213,7 +218,8 @@ def _gear_table(rows: Mapping) -> list[str]:
         L.append(
             f"| CalculiX | {r['element_mm']} | {r['dofs']} | {shares} | {pm} | {ab} | "
             f"{1e6 * res['theta_rad']:.2f} | {res['te_loaded_arcsec']:.3f} | "
-            f"{r['ccx_s']:.1f} (+{r['export_s']:.0f} export) | {r['peak_MB']:.0f} | {_load(r)} |"
+            f"{r['ccx_s']:.1f} (+{_f(r['export_s'], '.0f')} export){_timing(r)} | "
+            f"{_f(r['peak_MB'], '.0f')} | {_load(r)} |"
         )
     for r in rows["fegear"]:
         prs = r["pairs"]
@@ -286,7 +292,7 @@ def _hertz_summary(h: Mapping) -> list[str]:
         ff = _settled(sorted(h["fegear"], key=lambda r: r["level"]), keys, tol)
         if cc and ff:
             L.append(f"- Hertz scene, {what}: CalculiX {cc['element_mm']} mm in "
-                     f"{cc['ccx_s']:.0f} s and {cc['peak_MB']:.0f} MB; fegear hybrid level "
+                     f"{cc['ccx_s']:.0f} s and {_f(cc['peak_MB'], '.0f')} MB; fegear hybrid level "
                      f"{ff['level']} in {ff['cold_s']:.1f} s cold ({ff['warm_s']:.1f} s warm) "
                      f"and {ff['peak_MB']:.0f} MB: {cc['ccx_s'] / ff['cold_s']:.0f}x the cold "
                      "time.")  # fmt: skip
@@ -322,7 +328,7 @@ def summary(doc: Mapping) -> list[str]:
             )
             L.append(f"- {title}, {label}: CalculiX {own}; finest {fin['element_mm']} mm: lag "
                      f"{1e6 * fin['result']['theta_rad']:.2f} µrad, {fin['ccx_s']:.0f} s, "
-                     f"{fin['peak_MB']:.0f} MB.")  # fmt: skip
+                     f"{_f(fin['peak_MB'], '.0f')} MB.")  # fmt: skip
             for r in rows["fegear"]:
                 c = gear_comparison(rows, r)
                 eq = equal_accuracy(rows, r)
@@ -384,7 +390,7 @@ def _ccx_line(row: str, fin: Mapping, mv: Mapping | None) -> str:
     ab = ", ".join(_ab(p["semi_major_mm"], p["semi_minor_mm"]) for p in prs)
     te = f"{fin['result']['te_loaded_arcsec']:.3f}" + ("" if mv is None else moved(mv["te"]))
     return (f"| {row} | CalculiX {fin['element_mm']} mm | {sh} | {pm} | {ab} | {te} | "
-            f"{fin['ccx_s']:.0f} s | {fin['peak_MB']:.0f} |")  # fmt: skip
+            f"{fin['ccx_s']:.0f} s | {_f(fin['peak_MB'], '.0f')} |")  # fmt: skip
 
 
 def validation_section(doc: Mapping) -> str:
@@ -408,11 +414,11 @@ def validation_section(doc: Mapping) -> str:
         for r in ok:
             L.append(f"| Hertz scene | CalculiX {r['element_mm']} mm | {_pct(r['e_p0'])} | "
                      f"{_pct(r['e_a'])} | {_pct(r['e_b'])} | {r['ccx_s']:.0f} s | "
-                     f"{r['peak_MB']:.0f} |")  # fmt: skip
+                     f"{_f(r['peak_MB'], '.0f')} |")  # fmt: skip
         for r in h["fegear"]:
             L.append(f"| Hertz scene | fegear hybrid {r['level']} | {_pct(r['e_p0'])} | "
                      f"{_pct(r['e_a'])} | {_pct(r['e_b'])} | {r['cold_s']:.1f} s cold, "
-                     f"{r['warm_s']:.1f} s warm | {r['peak_MB']:.0f} |")  # fmt: skip
+                     f"{r['warm_s']:.1f} s warm | {_f(r['peak_MB'], '.0f')} |")  # fmt: skip
         L += [""] + _hertz_summary(h) + [""]
     L += ["| row | solver | load shares (k, j) | interior p_max MPa | semi-axes a × b mm | "
           "loaded TE arcsec | time | peak MB |",
