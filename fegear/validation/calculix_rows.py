@@ -454,7 +454,9 @@ def validation_section(doc: Mapping) -> str:
         mvs = "" if mv is None else (f"{mv:.4f}" if "shares" in c["check"] else _pct(mv))
         if c["holds"] is None:
             verdict = "not compared (no interior peak on one side)"
-        elif mv is not None and abs(mv) > c["bound"]:
+        elif mv is None:
+            verdict = "not decided: one CalculiX size only"
+        elif abs(mv) > c["bound"]:
             verdict = "not decided: CalculiX is not converged on it"
         else:
             verdict = "holds" if c["holds"] else "does NOT hold"
