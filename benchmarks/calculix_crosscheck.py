@@ -250,7 +250,7 @@ def gear_rows(key: str, work: Path, threads: int, ladders: list[list[float]]) ->
             r = ccx_row(path, work, threads, h, phi)
             rows["ccx"].append(r)
             res = r.get("result", {})
-            print(f"  {key} {label} ccx {h} mm: {r['ccx_s']:.0f} s, {r['peak_MB']:.0f} MB, "
+            print(f"  {key} {label} ccx {h} mm: {r['ccx_s']:.0f} s, {r['peak_MB']} MB, "
                   f"lag {res.get('theta_rad')}", file=sys.stderr, flush=True)  # fmt: skip
         out[label] = rows
     for fid, level in (("hybrid", 0), ("fe", 0)):

@@ -212,7 +212,7 @@ def _gear_table(rows: Mapping) -> list[str]:
                      f"{r['returncode']}) | | | | | {r['ccx_s']:.0f} | | {_load(r)} |")  # fmt: skip
             continue
         res, prs = r["result"], r["result"]["pairs"]
-        shares = ", ".join(f"({p['k']}, {p['j']}): {p['load_share']:.4f}" for p in prs)
+        shares = ", ".join(f"({p['k']}, {p['j']}): {p['load_share'] + 0.0:.4f}" for p in prs)
         pm = ", ".join(f"{_f(p['p_interior_MPa'], '.0f')} ({p['p_max_MPa']:.0f})" for p in prs)
         ab = ", ".join(_ab(p["semi_major_mm"], p["semi_minor_mm"]) for p in prs)
         L.append(
@@ -379,7 +379,7 @@ def _ccx_line(row: str, fin: Mapping, mv: Mapping | None) -> str:
     """The validation table's line of CalculiX's finest size (its last step's change)."""
     prs = fin["result"]["pairs"]
     moved = (lambda x: "") if mv is None else (lambda x: f" ({_pct(x)})")
-    sh = ", ".join(f"({p['k']}, {p['j']}) {p['load_share']:.4f}" for p in prs)
+    sh = ", ".join(f"({p['k']}, {p['j']}) {p['load_share'] + 0.0:.4f}" for p in prs)
     if mv is not None:
         sh += f" (±{mv['shares']:.4f})"
     pm = ", ".join(
