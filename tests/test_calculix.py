@@ -42,6 +42,19 @@ def _volumes(nodes: np.ndarray, elements: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0])
 
 
+#: The six edges of a C3D10 in the order of its mid-edge nodes 5..10 (CalculiX manual §6.2.7).
+EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
+
+
+def _mid_edge_offsets(xyz: np.ndarray, el: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(dev, length)``, ``(m, 6)`` mm each: how far each mid-edge node lies from its edge's
+    midpoint, and the edge's length."""
+    mid = np.stack([0.5 * (xyz[el[:, a]] + xyz[el[:, b]]) for a, b in EDGES], axis=1)
+    dev = np.linalg.norm(xyz[el[:, 4:]] - mid, axis=-1)
+    length = np.stack([np.linalg.norm(xyz[el[:, a]] - xyz[el[:, b]], axis=-1) for a, b in EDGES], 1)
+    return dev, length
+
+
 def _deck_elements(text: str) -> tuple[np.ndarray, np.ndarray]:
     """Nodes (by id) and C3D10 connectivity parsed back from a deck's text."""
     nodes: dict[int, list[float]] = {}
@@ -72,11 +85,7 @@ def test_hertz_deck_is_a_valid_c3d10_model():
     assert el.shape[1] == 10
     # orientation: every element positive (CalculiX rejects negative Jacobians)
     assert np.all(_volumes(xyz, el) > 0.0)
-    # mid-edge nodes 5..10 of edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4 (CalculiX manual §6.2.7)
-    edges = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
-    mid = np.stack([0.5 * (xyz[el[:, a]] + xyz[el[:, b]]) for a, b in edges], axis=1)
-    dev = np.linalg.norm(xyz[el[:, 4:]] - mid, axis=-1)
-    length = np.stack([np.linalg.norm(xyz[el[:, a]] - xyz[el[:, b]], axis=-1) for a, b in edges], 1)
+    dev, length = _mid_edge_offsets(xyz, el)  # mid-edge nodes against their edges' midpoints
     Rx, Ry = scene.roller_radii_mm
     # a move onto the barrel is the chord's sag, at most L² / (8 r) for an edge of length L on a
     # section of radius r >= 0.9 Rx (the crown lowers the section radius by < 10 % here)
@@ -130,9 +139,7 @@ def test_spiral_bevel_deck_is_valid_with_a_pair_per_closing_tooth_pair():
     xyz, el = _deck_elements(deck.text)
     assert el.shape[1] == 10
     assert np.all(_volumes(xyz, el) > 0.0)
-    edges = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
-    mid = np.stack([0.5 * (xyz[el[:, a]] + xyz[el[:, b]]) for a, b in edges], axis=1)
-    dev = np.linalg.norm(xyz[el[:, 4:]] - mid, axis=-1)
+    dev, _ = _mid_edge_offsets(xyz, el)
     rec = deck.record
     # a mid-edge node moves only onto the flank, by at most the largest move the record states
     assert np.max(dev) <= max(rec["projected_mm"].values()) + 1e-9
