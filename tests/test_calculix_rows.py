@@ -13,6 +13,7 @@ from fegear.validation.calculix_rows import (
     equal_accuracy,
     gear_comparison,
     markdown,
+    richardson,
     validation_section,
 )
 
@@ -104,3 +105,45 @@ def test_the_measured_rows_render():
     doc = json.loads(RESULTS.read_text(encoding="utf-8"))
     assert "## At equal accuracy" in markdown(doc)
     assert "Acceptance bounds" in validation_section(doc)
+
+
+def test_richardson_recovers_a_known_limit_and_order():
+    # f(h) = 3 + 0.5 h^2 on unequal steps (2, 1.4, 1 mm): the limit 3 and the order 2 exactly
+    # (to the fixed point's 1e-10); GCI = 1.25 |f1 - f2| / |f1| / (r21^p - 1) by hand
+    h = [2.0, 1.4, 1.0]
+    ext = richardson(h, [3 + 0.5 * x**2 for x in h])
+    assert ext.value == pytest.approx(3.0, abs=1e-9) and ext.order == pytest.approx(2.0, abs=1e-8)
+    assert ext.gci == pytest.approx(1.25 * (0.5 * 1.96 - 0.5) / 3.5 / (1.4**2 - 1), rel=1e-8)
+    assert ext.sizes == (2.0, 1.4, 1.0)
+    # a first-order quantity approached from above, given fine to coarse with a coarser extra
+    hs = [0.5, 1.0, 2.0, 4.0]
+    ext = richardson(hs, [-7.0 - 2.0 * x for x in hs])
+    assert ext.value == pytest.approx(-7.0, abs=1e-9) and ext.order == pytest.approx(1.0)
+    assert ext.sizes == (2.0, 1.0, 0.5)  # the three finest
+
+
+def test_richardson_refuses_what_is_not_in_the_asymptotic_range():
+    assert richardson([2.0, 1.0], [1.0, 2.0]) is None  # two sizes
+    assert richardson([2.0, 1.4, 1.0], [1.0, 2.0, 1.5]) is None  # oscillating
+    assert richardson([2.0, 1.4, 1.0], [1.0, 1.0, 1.0]) is None  # stalled
+    # the last step moves more than the one before: an observed order below 0.5 (diverging)
+    assert richardson([2.0, 1.0, 0.5], [1.0, 1.1, 1.4]) is None
+
+
+def test_criteria_check_the_te_against_the_extrapolated_calculix(section):
+    rows = section["face_gear"]["two pairs"]
+    # a third, finer size on f(h) = -21.6 + 1.6 h^1 (sizes 1, 0.5, 0.25): the limit -21.6
+    rows["ccx"][0]["result"]["te_loaded_arcsec"] = -20.0
+    rows["ccx"][1]["result"]["te_loaded_arcsec"] = -20.8
+    rows["ccx"].append(_ccx(0.25, {(0, 0): 0.575, (1, 1): 0.425}, 1.05e-4, -21.2,
+                            {(0, 0): 790.0, (1, 1): 700.0}, 900.0))  # fmt: skip
+    (te,) = [c for c in criteria(section) if c["check"] == "loaded TE within 5 %"]
+    ext = te["extrapolation"]
+    assert ext.value == pytest.approx(-21.6) and ext.order == pytest.approx(1.0)
+    assert te["value"] == pytest.approx(20.4 / 21.6 - 1)  # -5.6 %: outside the bound
+    assert te["ccx_moves"] == pytest.approx(1.25 * 0.4 / 21.2)  # GCI 2.4 %: decided
+    assert not te["holds"]
+    text = validation_section(section)
+    assert "loaded TE within 5 %: -5.56% against CalculiX extrapolated to zero element size " \
+        "(-21.600″ from 1, 0.5, 0.25 mm, observed order 1.00, GCI ±2.36%): does NOT hold." \
+        in text  # fmt: skip
