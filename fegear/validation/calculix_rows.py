@@ -425,7 +425,8 @@ def criteria(doc: Mapping) -> list[dict]:
     """Each gear position's acceptance checks against CalculiX's finest size (fegear
     ``hybrid`` level 0): ``{"row", "check", "value", "bound", "holds", "ccx_moves"}`` (the
     loaded TE's also ``"extrapolation"``, :class:`Extrapolation`, when CalculiX's ladder gives
-    one: then ``value`` is against the extrapolated TE and ``ccx_moves`` is its GCI);
+    one: then ``value`` is against the extrapolated TE and ``ccx_moves`` is its GCI; else
+    ``"not_extrapolated"``: True when three sizes or more did not give one);
     ``holds`` is None where the quantity is not defined (p_max with no interior peak on one
     side)."""
     out = []
@@ -452,7 +453,8 @@ def criteria(doc: Mapping) -> list[dict]:
             if ext is None:
                 out.append({"row": row, "check": "loaded TE within 5 %", "value": c["te"],
                             "bound": TE_TOL, "holds": abs(c["te"]) <= TE_TOL,
-                            "ccx_moves": None if mv is None else mv["te"]})  # fmt: skip
+                            "ccx_moves": None if mv is None else mv["te"],
+                            "not_extrapolated": len(ok) >= 3})  # fmt: skip
             else:  # against the extrapolated value; its GCI is what CalculiX leaves open
                 te = _rel(hyb[0]["te_loaded"], ext.value)
                 out.append({"row": row, "check": "loaded TE within 5 %", "value": te,
@@ -556,6 +558,11 @@ def validation_section(doc: Mapping) -> str:
             verdict = "not decided: CalculiX is not converged on it"
         else:
             verdict = "holds" if c["holds"] else "does NOT hold"
+        if c.get("not_extrapolated"):
+            verdict += (
+                " (against the finest size: CalculiX's three finest do not converge "
+                "monotonically at an order of at least 0.5, so it is not extrapolated)"
+            )
         L.append(f"- {c['row']}: {c['check']}: {val} (CalculiX moves {mvs or '—'}): "
                  f"{verdict}.")  # fmt: skip
     fzg = doc.get("fzg", {})
