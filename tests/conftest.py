@@ -45,3 +45,13 @@ def pytest_unconfigure(config: pytest.Config) -> None:
 def fegear_cache() -> Path:
     """The session's private artefact cache folder."""
     return Path(os.environ["FEGEAR_CACHE"])
+
+
+@pytest.fixture(scope="session")
+def spiral_bevel_pair():
+    """The default spiral bevel pair, ``SpiralBevelPair.design()``, synthesized once for the
+    session (10-25 s: the third-order roll is tuned on the unloaded TE) and shared by the test
+    modules that use it as it is (a frozen dataclass; its members' caches only memoize)."""
+    from fegear.geometry.spiral_bevel import SpiralBevelPair
+
+    return SpiralBevelPair.design()

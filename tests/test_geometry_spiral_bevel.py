@@ -27,8 +27,8 @@ SIDES = ("drive", "coast")
 
 
 @pytest.fixture(scope="module")
-def pair() -> SpiralBevelPair:
-    return SpiralBevelPair.design()
+def pair(spiral_bevel_pair) -> SpiralBevelPair:
+    return spiral_bevel_pair  # the session's (tests/conftest.py)
 
 
 def members(pair):

@@ -12,15 +12,14 @@ import numpy as np
 import pytest
 
 from fegear.geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
-from fegear.geometry.spiral_bevel import SpiralBevelPair
 from fegear.ltca import LTCAOptions, build_models, run_ltca
 
 OPTIONS = LTCAOptions(n_positions=9, level=0)
 
 
 @pytest.fixture(scope="module")
-def bevel():
-    pair = SpiralBevelPair.design()
+def bevel(spiral_bevel_pair):
+    pair = spiral_bevel_pair  # the session's (tests/conftest.py)
     asm = spiral_bevel_assembly(pair, "drive", InstallationErrors())
     return pair, asm, build_models(pair.pinion, pair.gear, asm, OPTIONS)
 

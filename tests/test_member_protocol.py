@@ -53,10 +53,8 @@ def helical() -> InvoluteMember:
 
 
 @pytest.fixture(scope="module")
-def bevel_pair():
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
-
-    return SpiralBevelPair.design()  # ~10 s, once for the module
+def bevel_pair(spiral_bevel_pair):
+    return spiral_bevel_pair  # the session's (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

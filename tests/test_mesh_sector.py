@@ -50,10 +50,8 @@ def face_gear_pinion() -> InvoluteMember:
 
 
 @pytest.fixture(scope="session")
-def bevel_pair():
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
-
-    return SpiralBevelPair.design()
+def bevel_pair(spiral_bevel_pair):
+    return spiral_bevel_pair  # the session's (tests/conftest.py)
 
 
 # every family at least in the slow suite; FZG pinion + face gear in the default one

@@ -20,8 +20,8 @@ DG = 0.02  # deg, Δγ of the error study
 
 
 @pytest.fixture(scope="module")
-def pair() -> SpiralBevelPair:
-    return SpiralBevelPair.design()  # ~10 s: once per module
+def pair(spiral_bevel_pair) -> SpiralBevelPair:
+    return spiral_bevel_pair  # the session's (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")
