@@ -24,7 +24,9 @@ def pytest_configure(config: pytest.Config) -> None:
     """Point ``$FEGEAR_CACHE`` at a fresh folder before any test module is imported: the tests
     start cold and never read or write the user's cache (the per-user cache folder, or a
     ``$FEGEAR_CACHE`` of the shell, which this overrides); subprocesses inherit it. Removed,
-    and the old value restored, at the end of the session (a face-gear cache is ~100 MB)."""
+    and the old value restored, at the end of the session (a face-gear cache is ~100 MB). Under
+    pytest-xdist every worker process runs this too and has a folder of its own: the tests that
+    count the cache's hits and builds, or clear it, never see another process's entries."""
     root = tempfile.mkdtemp(prefix="fegear_test_cache_")
     config._fegear_cache = (root, os.environ.get("FEGEAR_CACHE"))  # type: ignore[attr-defined]
     os.environ["FEGEAR_CACHE"] = root
