@@ -306,3 +306,14 @@ def test_an_unusable_fegear_cache_exits_2_naming_it(monkeypatch, tmp_path, capsy
     assert "FEGEAR_CACHE" in err and "Read-only file system" in err
     assert main(["sweep", str(FZG), "--out", str(tmp_path / "s"), "-q"]) == 2
     assert "FEGEAR_CACHE" in capsys.readouterr().err
+
+
+def test_joined_cache_use_adds_the_counts_per_kind(tmp_path):
+    """A run whose fields are computed after its numbers reports both pieces' lookups as one
+    record: every kind's hits and builds added, the kinds of either kept."""
+    a = fcache.CacheUse(tmp_path, {"mesh": 2, "tca": 1}, {"fields": 1})
+    b = fcache.CacheUse(tmp_path, {"tca": 2}, {"fields": 1, "layer": 3})
+    j = a.joined(b)
+    assert j.root == tmp_path
+    assert j.hits == {"mesh": 2, "tca": 3} and j.built == {"fields": 2, "layer": 3}
+    assert not j.warm and fcache.CacheUse(tmp_path, {"tca": 1}, {}).joined(a).hits["tca"] == 2

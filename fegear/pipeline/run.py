@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import logging
 import time
-from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -211,17 +210,8 @@ def with_fields(run: GearRun, progress: Progress | None = None) -> GearRun:
         members = displacements(run.pair, run.assembly, run.cycle.models, run.cycle, run.phi2,
                                 root_stress=c.root_stress, backend=c.backend)  # fmt: skip
     seconds = {**run.seconds, "displacements": time.perf_counter() - t0}
-    return replace(run, members=members, seconds=seconds, cache=_joined(run.cache, used()))
-
-
-def _joined(a: CacheUse | None, b: CacheUse) -> CacheUse:
-    """The lookups of ``a`` and ``b`` together."""
-    if a is None:
-        return b
-    hits, built = Counter(a.hits), Counter(a.built)
-    hits.update(b.hits)
-    built.update(b.built)
-    return CacheUse(a.root, dict(sorted(hits.items())), dict(sorted(built.items())))
+    cache = used() if run.cache is None else run.cache.joined(used())
+    return replace(run, members=members, seconds=seconds, cache=cache)
 
 
 def _ellipses(case: GearCase, tca, positions) -> tuple:

@@ -404,6 +404,13 @@ class CacheUse:
         """JSON-ready (``summary.json``: ``cache``)."""
         return {"folder": str(self.root), "hits": dict(self.hits), "built": dict(self.built)}
 
+    def joined(self, other: CacheUse) -> CacheUse:
+        """The lookups of this and ``other`` together (counts added per kind; this root)."""
+        hits, built = Counter(self.hits), Counter(self.built)
+        hits.update(other.hits)
+        built.update(other.built)
+        return CacheUse(self.root, dict(sorted(hits.items())), dict(sorted(built.items())))
+
 
 @dataclass
 class _Recorder:
