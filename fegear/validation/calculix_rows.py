@@ -535,7 +535,10 @@ def validation_section(doc: Mapping) -> str:
           "**Acceptance bounds** (fegear `hybrid` level 0 against CalculiX's finest size; "
           "CalculiX's own change over its last refinement step in brackets: a bound checked "
           "against a CalculiX value that still moves by more than the bound is not decided by "
-          "this ladder):", ""]  # fmt: skip
+          "this ladder; the loaded TE against CalculiX extrapolated to zero element size where "
+          "three sizes allow it, decided when the extrapolation's GCI is within the bound, "
+          "[calculix.md](calculix.md#calculix-extrapolated-to-zero-element-size)):",
+          ""]  # fmt: skip
     for c in criteria(doc):
         val = f"{c['value']:.4f}" if "shares" in c["check"] else _pct(c["value"])
         mv = c["ccx_moves"]
