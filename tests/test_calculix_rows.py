@@ -147,3 +147,25 @@ def test_criteria_check_the_te_against_the_extrapolated_calculix(section):
     assert "loaded TE within 5 %: -5.56% against CalculiX extrapolated to zero element size " \
         "(-21.600″ from 1, 0.5, 0.25 mm, observed order 1.00, GCI ±2.36%): does NOT hold." \
         in text  # fmt: skip
+
+
+def test_unresolved_pressure_and_an_unbounded_ladder_decide_nothing(section):
+    rows = section["face_gear"]["two pairs"]
+    # CalculiX's pressures of pair (0, 0) integrate to 7.4 times its force: however little its
+    # p_max moves, it is not a reference
+    for r in rows["ccx"]:
+        for p in r["result"]["pairs"]:
+            p["normal_force_N"], p["nodal_force_N"] = 1000.0, 7400.0 if p["k"] == 0 else 1020.0
+            p["p_interior_MPa"] = 800.0 if p["k"] == 0 else 700.0
+    # a third size whose lag step grows (0.8 then 1.0 arcsec): no order, no extrapolation
+    rows["ccx"].append(_ccx(0.25, {(0, 0): 0.58, (1, 1): 0.42}, 1.06e-4, -21.8,
+                            {(0, 0): 800.0, (1, 1): 700.0}, 900.0))  # fmt: skip
+    for p in rows["ccx"][-1]["result"]["pairs"]:
+        p["normal_force_N"], p["nodal_force_N"] = 1000.0, 7400.0 if p["k"] == 0 else 1020.0
+    by = {c["check"]: c for c in criteria(section)}
+    assert by["interior p_max of pair (0, 0) within 5 %"]["pressure_integral"] == pytest.approx(7.4)
+    assert by["loaded TE within 5 %"]["not_extrapolated"]
+    text = validation_section(section)
+    assert "integrate to 7.40 times the pair's contact force (its pressure is not resolved)" in text
+    assert "loaded TE within 5 %: -6.42% (CalculiX moves +4.81%): not decided: CalculiX's three " \
+        "finest sizes do not converge" in text  # fmt: skip

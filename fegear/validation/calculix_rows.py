@@ -102,6 +102,14 @@ def _ccx_interior(r: Mapping) -> dict:
     return {(p["k"], p["j"]): p["p_interior_MPa"] for p in r["result"]["pairs"]}
 
 
+def _pressure_integral(r: Mapping) -> dict:
+    """Per pair of a CalculiX row: its nodal pressures integrated over their tributary areas
+    over its contact force (1 where the pressure field is resolved); absent where not read."""
+    return {(p["k"], p["j"]): p["nodal_force_N"] / p["normal_force_N"]
+            for p in r["result"]["pairs"]
+            if p.get("nodal_force_N") and p.get("normal_force_N")}  # fmt: skip
+
+
 def _loaded(shares: Mapping, floor: float = 0.05) -> int:
     """Pairs carrying more than ``floor`` of the torque."""
     return sum(1 for s in shares.values() if s > floor)
@@ -426,7 +434,9 @@ def criteria(doc: Mapping) -> list[dict]:
     ``hybrid`` level 0): ``{"row", "check", "value", "bound", "holds", "ccx_moves"}`` (the
     loaded TE's also ``"extrapolation"``, :class:`Extrapolation`, when CalculiX's ladder gives
     one: then ``value`` is against the extrapolated TE and ``ccx_moves`` is its GCI; else
-    ``"not_extrapolated"``: True when three sizes or more did not give one);
+    ``"not_extrapolated"``: True when three sizes or more did not give one: not decided; the
+    p_max checks' ``"pressure_integral"``: CalculiX's nodal pressures integrated over the pair's
+    contact force, not decided when it is off 1 by more than the bound);
     ``holds`` is None where the quantity is not defined (p_max with no interior peak on one
     side)."""
     out = []
@@ -443,12 +453,14 @@ def criteria(doc: Mapping) -> list[dict]:
                             "value": c["shares"], "bound": SHARE_TOL,
                             "holds": c["shares"] <= SHARE_TOL,
                             "ccx_moves": None if mv is None else mv["shares"]})  # fmt: skip
+            integral = _pressure_integral(ok[-1])
             for k, v in c["p_interior"].items():
                 out.append({"row": row, "check": f"interior p_max of pair {k} within 5 %",
                             "value": v, "bound": P_TOL,
                             "holds": None if v is None else abs(v) <= P_TOL,
                             "ccx_moves": None if mv is None else
-                            mv["p_interior"].get(k)})  # fmt: skip
+                            mv["p_interior"].get(k),
+                            "pressure_integral": integral.get(k)})  # fmt: skip
             ext = te_extrapolation(rows)
             if ext is None:
                 out.append({"row": row, "check": "loaded TE within 5 %", "value": c["te"],
@@ -553,19 +565,22 @@ def validation_section(doc: Mapping) -> str:
                         if ext.gci > c["bound"] else
                         "holds" if c["holds"] else "does NOT hold") + ".")  # fmt: skip
             continue
+        integral = c.get("pressure_integral")
         if c["holds"] is None:
             verdict = "not compared (no interior peak on one side)"
+        elif integral is not None and abs(integral - 1.0) > c["bound"]:
+            verdict = (f"not decided: CalculiX's nodal pressures integrate to {integral:.2f} "
+                       "times the pair's contact force (its pressure is not resolved)")  # fmt: skip
         elif mv is None:
             verdict = "not decided: one CalculiX size only"
+        elif c.get("not_extrapolated"):
+            verdict = ("not decided: CalculiX's three finest sizes do not converge at an order "
+                       "of at least 0.5 (no extrapolation), so its finest value is not bounded "
+                       "by its ladder")  # fmt: skip
         elif abs(mv) > c["bound"]:
             verdict = "not decided: CalculiX is not converged on it"
         else:
             verdict = "holds" if c["holds"] else "does NOT hold"
-        if c.get("not_extrapolated"):
-            verdict += (
-                " (against the finest size: CalculiX's three finest do not converge "
-                "monotonically at an order of at least 0.5, so it is not extrapolated)"
-            )
         L.append(f"- {c['row']}: {c['check']}: {val} (CalculiX moves {mvs or '—'}): "
                  f"{verdict}.")  # fmt: skip
     fzg = doc.get("fzg", {})
