@@ -493,6 +493,42 @@ def _ccx_line(row: str, fin: Mapping, mv: Mapping | None) -> str:
             f"{fin['ccx_s']:.0f} s | {_f(fin['peak_MB'], '.0f')} |")  # fmt: skip
 
 
+def _against(c: Mapping) -> str:
+    """What a check's value is measured against: CalculiX's last change, or its extrapolation."""
+    ext = c.get("extrapolation")
+    if ext is not None:
+        sizes = ", ".join(f"{h:g}" for h in ext.sizes)
+        return (
+            f"against CalculiX extrapolated to zero element size ({ext.value:.3f}″ from "
+            f"{sizes} mm, observed order {ext.order:.2f}, GCI ±{100 * ext.gci:.2f}%)"
+        )
+    mv = c["ccx_moves"]
+    mvs = "—" if mv is None else (f"{mv:.4f}" if "shares" in c["check"] else _pct(mv))
+    return f"(CalculiX moves {mvs})"
+
+
+def _verdict(c: Mapping) -> str:
+    """A check of :func:`criteria` decided, or why not (the rules of ``docs/calculix.md``)."""
+    mv, integral = c["ccx_moves"], c.get("pressure_integral")
+    if c["holds"] is None:
+        return "not compared (no interior peak on one side)"
+    if integral is not None and abs(integral - 1.0) > c["bound"]:
+        return (f"not decided: CalculiX's nodal pressures integrate to {integral:.2f} times the "
+                "pair's contact force (its pressure is not resolved)")  # fmt: skip
+    if c.get("extrapolation") is not None and mv > c["bound"]:
+        return "not decided: CalculiX's uncertainty exceeds the bound"
+    if mv is None:
+        return "not decided: one CalculiX size only"
+    if c.get("not_extrapolated"):
+        return (
+            "not decided: CalculiX's three finest sizes do not converge at an order of at "
+            "least 0.5 (no extrapolation), so its finest value is not bounded by its ladder"
+        )
+    if abs(mv) > c["bound"]:
+        return "not decided: CalculiX is not converged on it"
+    return "holds" if c["holds"] else "does NOT hold"
+
+
 def validation_section(doc: Mapping) -> str:
     """The section of ``docs/validation.md``: per row, CalculiX's finest size beside fegear
     ``hybrid`` and ``fe`` level 0, and the acceptance checks with CalculiX's own movement."""
@@ -553,36 +589,7 @@ def validation_section(doc: Mapping) -> str:
           ""]  # fmt: skip
     for c in criteria(doc):
         val = f"{c['value']:.4f}" if "shares" in c["check"] else _pct(c["value"])
-        mv = c["ccx_moves"]
-        mvs = "" if mv is None else (f"{mv:.4f}" if "shares" in c["check"] else _pct(mv))
-        ext = c.get("extrapolation")
-        if ext is not None:
-            sizes = ", ".join(f"{h:g}" for h in ext.sizes)
-            L.append(f"- {c['row']}: {c['check']}: {val} against CalculiX extrapolated to zero "
-                     f"element size ({ext.value:.3f}″ from {sizes} mm, observed order "
-                     f"{ext.order:.2f}, GCI ±{100 * ext.gci:.2f}%): "
-                     + ("not decided: CalculiX's uncertainty exceeds the bound"
-                        if ext.gci > c["bound"] else
-                        "holds" if c["holds"] else "does NOT hold") + ".")  # fmt: skip
-            continue
-        integral = c.get("pressure_integral")
-        if c["holds"] is None:
-            verdict = "not compared (no interior peak on one side)"
-        elif integral is not None and abs(integral - 1.0) > c["bound"]:
-            verdict = (f"not decided: CalculiX's nodal pressures integrate to {integral:.2f} "
-                       "times the pair's contact force (its pressure is not resolved)")  # fmt: skip
-        elif mv is None:
-            verdict = "not decided: one CalculiX size only"
-        elif c.get("not_extrapolated"):
-            verdict = ("not decided: CalculiX's three finest sizes do not converge at an order "
-                       "of at least 0.5 (no extrapolation), so its finest value is not bounded "
-                       "by its ladder")  # fmt: skip
-        elif abs(mv) > c["bound"]:
-            verdict = "not decided: CalculiX is not converged on it"
-        else:
-            verdict = "holds" if c["holds"] else "does NOT hold"
-        L.append(f"- {c['row']}: {c['check']}: {val} (CalculiX moves {mvs or '—'}): "
-                 f"{verdict}.")  # fmt: skip
+        L.append(f"- {c['row']}: {c['check']}: {val} {_against(c)}: {_verdict(c)}.")
     fzg = doc.get("fzg", {})
     pitch = fzg.get("pitch point")
     if pitch and "line_hertz_p0_MPa" in fzg:
