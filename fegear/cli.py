@@ -100,6 +100,12 @@ def _parser() -> argparse.ArgumentParser:
         "sectors); overrides the case's [analysis] root_stress",
     )
     r.add_argument(
+        "--recompute",
+        action="store_true",
+        help="gear pairs: solve the mesh positions again even if the same run (same case, "
+        "fidelity, level and code) is in the cache",
+    )
+    r.add_argument(
         "--overwrite",
         action="store_true",
         help="write into an output folder that holds files fegear did not write (they are "
@@ -234,6 +240,11 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         writing = "displacement fields (one sparse solve per member) and outputs"
     stages.append(("writing", writing))
     labels = {s: f"[{i}/{len(stages)}] {text}" for i, (s, text) in enumerate(stages, 1)}
+    if kind is not None:  # the loaded cycle of the same run read back (fegear.ltca.cached)
+        labels["cached"] = (
+            f"[2-3/{len(stages)}] models and mesh positions: the same run is in the cache, "
+            "read back (--recompute solves it again)"
+        )
     stage_t = {"t": t_start, "started": False}
 
     def progress(stage: str, i: int | None, n: int | None) -> None:
@@ -263,6 +274,7 @@ def _run_gear(args: argparse.Namespace, case) -> int:
         progress=progress,
         notify=warn,
         fields=False,  # computed by write, beside the pictures (fegear.output.gear_output)
+        reuse=not args.recompute,
     )
     progress("writing", None, None)
     paths = result.write(out, overwrite=args.overwrite)

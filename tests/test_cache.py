@@ -69,7 +69,7 @@ def _case(tmp_path: Path) -> Path:
 
 def test_two_working_directories_share_one_cache(monkeypatch, tmp_path):
     """``fegear run`` of the same case from two fresh folders: the first builds the meshes,
-    operators and TCA in the per-user cache, the second reads every one of them back."""
+    operators, TCA and loaded cycle in the per-user cache, the second reads the run back."""
     root = _user_cache_in(monkeypatch, tmp_path)
     case = _case(tmp_path)
     docs = []
@@ -83,11 +83,11 @@ def test_two_working_directories_share_one_cache(monkeypatch, tmp_path):
         assert not (work / "meshes").exists()  # nothing cached under the working directory
     first, second = (d["cache"] for d in docs)
     assert first["folder"] == second["folder"] == str(root)
-    assert {"mesh", "compliance", "tca"} <= set(first["built"])
-    # warm: every artefact the first run built, the second read; it built nothing
+    assert {"mesh", "compliance", "tca", "cycle", "member_fields"} <= set(first["built"])
+    # warm: the second built nothing and read the run back (TCA, loaded cycle, fields), with
+    # no need of the meshes and operators the cycle was solved on
     assert second["built"] == {}
-    assert set(first["built"]) <= set(second["hits"])
-    assert second["hits"]["mesh"] >= first["built"]["mesh"]
+    assert {"tca", "cycle", "member_fields"} <= set(second["hits"])
     te = [[p["te_loaded_arcsec"] for p in d["positions"]] for d in docs]
     assert te[0] == te[1]  # the same operators: the same numbers
     assert (root / fcache.CACHE_TAG).read_text().startswith("Signature: 8a477f597d28d172")
@@ -105,8 +105,11 @@ def test_main_job_from_two_folders_shares_one_cache(monkeypatch, tmp_path):
         monkeypatch.chdir(work)
         assert main(["run", "-q"]) == 0
         docs.append(json.loads((work / "out" / "summary.json").read_text()))
-    assert {"mesh", "compliance"} <= set(docs[0]["cache"]["built"])
-    assert docs[1]["cache"]["built"] == {} and docs[1]["cache"]["hits"]["compliance"] >= 2
+    assert {"mesh", "compliance", "cycle"} <= set(docs[0]["cache"]["built"])
+    # the same run again: its loaded cycle and fields read back, no mesh or operator even read
+    assert docs[1]["cache"]["built"] == {}
+    assert docs[1]["cache"]["hits"]["cycle"] == 1 and docs[1]["cache"]["hits"]["member_fields"] == 1
+    assert "compliance" not in docs[1]["cache"]["hits"]
 
 
 # --------------------------------------------------------------------------------------------

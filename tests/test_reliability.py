@@ -487,7 +487,7 @@ def test_workers_one_and_two_give_the_same_numbers_at_hybrid(tmp_path, fzg_shipp
         out = tmp_path / f"w{w}"
         res = subprocess.run(
             [sys.executable, "-m", "fegear.cli", "run", str(FZG), "--out", str(out), "-q",
-             "--workers", w],
+             "--workers", w, "--recompute"],  # both solve (the second would read the first)
             env=env, capture_output=True, text=True, timeout=600,
         )  # fmt: skip
         assert res.returncode == 0, res.stderr

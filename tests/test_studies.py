@@ -12,9 +12,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import fegear
+from fegear.store.cache import clear_cache
 
 REPO = Path(__file__).resolve().parents[1]
 FACE_GEAR = REPO / "cases" / "face_gear_nominal.toml"
@@ -57,3 +59,56 @@ def test_a_study_reads_the_meshes_and_operators_of_the_nominal_run(seed_case, wh
         # the error-free pair read
         assert use.built.get("tca", 0) >= 1 and "phase" not in use.built, (what, use)
         assert use.hits.get("phase", 0) >= 1, (what, use)
+    # the loaded cycle is keyed on the installation, the torque and the fidelity: solved again
+    assert use.built.get("cycle") == 1 and "cycle" not in use.hits, (what, use)
+
+
+def _cycle_numbers(result):
+    """Every number of the loaded cycle that the solve produces, flattened: TEs, the lag, the
+    cell forces and gaps of every position."""
+    c = result.run.cycle
+    parts = [c.te_loaded_arcsec, c.te_unloaded_arcsec]
+    for p in c.positions:
+        parts += [np.atleast_1d(p.theta)]
+        if p.solution is not None:
+            parts += [p.solution.force, p.solution.gap]
+        parts += [cells.centers.ravel() for cells in p.cells]
+    return np.concatenate([np.asarray(x, dtype=float).ravel() for x in parts])
+
+
+def test_the_same_run_again_reads_its_cycle_and_fields_bit_for_bit(seed_case):
+    """A run repeated with the same inputs reads its loaded cycle and displacement fields back
+    (``docs/ltca/studies.md``, "The same run again") without reading a mesh or an operator, and
+    they are the ones a fresh solve gives, bit for bit (floats are stored by their repr)."""
+    case = seed_case.replace(torque2_Nm=1500.0)
+    first = fegear.run(case, workers=1)
+    assert first.run.cache.built.get("cycle") == 1
+    again = fegear.run(case, workers=1)
+    use = again.run.cache
+    assert use.built == {}, use
+    assert use.hits.get("cycle") == 1 and use.hits.get("member_fields") == 1, use
+    assert "mesh" not in use.hits and "compliance" not in use.hits, use
+    fresh = fegear.run(case, workers=1, reuse=False)  # solved again, the cache left alone
+    assert "cycle" not in fresh.run.cache.hits and "cycle" not in fresh.run.cache.built
+    assert "member_fields" not in fresh.run.cache.hits
+    np.testing.assert_array_equal(_cycle_numbers(again), _cycle_numbers(fresh))
+    np.testing.assert_array_equal(_cycle_numbers(first), _cycle_numbers(fresh))
+    for a, b in zip(again.run.members, fresh.run.members, strict=True):
+        assert a.name == b.name
+        np.testing.assert_array_equal(a.displacement, b.displacement)
+        np.testing.assert_array_equal(a.points, b.points)
+
+
+def test_fields_of_a_cycle_read_back_are_those_of_its_models(seed_case):
+    """A cycle read from the cache has no models; when its fields are not in the cache either,
+    the models are built (read) on the cycle's contact zone and the fields computed: the same
+    fields as the run that solved the cycle."""
+    case = seed_case.with_errors(dE_mm=0.05)
+    first = fegear.run(case, workers=1)
+    clear_cache("member_fields")
+    again = fegear.run(case, workers=1)
+    use = again.run.cache
+    assert use.hits.get("cycle") == 1 and use.built.get("member_fields") == 1, use
+    assert use.hits.get("compliance") == 8 and "compliance" not in use.built, use
+    for a, b in zip(again.run.members, first.run.members, strict=True):
+        np.testing.assert_array_equal(a.displacement, b.displacement)

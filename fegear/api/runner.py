@@ -24,7 +24,8 @@ __all__ = ["Progress", "load_case", "run"]
 log = logging.getLogger(__name__)
 
 #: ``progress(stage, i, n)``: called at the start of each stage (``i = n = None``; gear pairs:
-#: ``"geometry"``, ``"tca"`` or ``"models"``, ``"positions"``, ``"displacements"``; the Hertz
+#: ``"geometry"``, ``"tca"`` or ``"models"``, ``"positions"`` (or ``"cached"``: the loaded cycle
+#: of the same run read back), ``"displacements"``; the Hertz
 #: scene: ``"study"`` with ``i`` of ``n`` levels, ``"run"``) and after each mesh position
 #: (``"positions"``, ``i`` of ``n``).
 Progress = Callable[[str, "int | None", "int | None"], None]
@@ -81,6 +82,7 @@ def run(
     progress: Progress | None = None,
     notify: Callable[[str], None] | None = None,
     fields: bool = True,
+    reuse: bool = True,
 ) -> GearResult | HertzResult:
     """Run a case.
 
@@ -119,6 +121,10 @@ def run(
         the numbers only, for a study that reads numbers (every number of the result but the
         ``mesh`` sizes of the fields, which stay empty); :meth:`GearResult.write` then computes
         the fields it writes (the same ones). ``root_stress`` computes them always.
+    reuse
+        Gear pairs at a loaded fidelity: read the positions (and the fields) of a run made
+        before with the same inputs from the cache (``docs/ltca/studies.md``); False: solve
+        them again.
 
     Returns
     -------
@@ -161,6 +167,8 @@ def run(
         raise InputError("level", lvl, f"an integer in [0, {N_LEVELS - 1}]")
     if workers is not None and not (isinstance(workers, int) and workers >= 1):
         raise InputError("workers", workers, "an integer >= 1")
+    if not isinstance(reuse, bool):
+        raise InputError("reuse", reuse, "True or False")
     pair = build_pair(case)  # bad design data is refused here, before any work
     gear_run = run_gear_case(
         case,
@@ -171,5 +179,6 @@ def run(
         workers=workers,
         notify=notify,
         fields=fields,
+        reuse=reuse,
     )
     return gear_result(gear_run, flank_views(gear_run), workers)

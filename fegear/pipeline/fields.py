@@ -20,6 +20,8 @@ from fegear.fem.elasticity import assemble_body
 from fegear.fem.stress import (
     CONTACT_CLEARANCE_MODULES,
     FILLET_MODULES,
+    Equilibrium,
+    ToothRootStress,
     VertexStress,
     fillet_regions,
     principal_stresses,
@@ -34,8 +36,9 @@ from fegear.mesh.sector import FILLET_TRIANGLES, FINE, default_zone, sector_mesh
 from fegear.mesh.sector_geometry import sector_frame
 from fegear.pipeline.pair import GearPair
 from fegear.store.cache import cached_record
+from fegear.store.records import registry
 
-__all__ = ["MemberField", "displacements", "stress_sector"]
+__all__ = ["FIELD_CLASSES", "MemberField", "displacements", "stress_sector"]
 
 log = logging.getLogger(__name__)
 
@@ -120,6 +123,10 @@ class MemberField:
                     out[i] = getattr(r, what)
         return out
 
+
+#: The classes of a cached tuple of :class:`MemberField` (:mod:`fegear.store.records`; kept
+#: without ``dofs`` and ``body``).
+FIELD_CLASSES = registry(MemberField, ToothRootStress, Equilibrium)
 
 #: Factorised stress sectors kept in the process (the last pair): runs of the same pair in one
 #: process (sweeps, scripts, the test session) solve by back-substitution only. A 190k-DOF FZG

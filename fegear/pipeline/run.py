@@ -4,7 +4,8 @@
 :class:`GearRun` that :func:`fegear.output.gear_output.write_gear_outputs` turns into files.
 The library logs; the caller gets progress through an optional callback
 ``progress(stage, i, n)`` (``i``/``n`` are the position counters of the position stage and
-``None`` otherwise).
+``None`` otherwise; stage ``"cached"`` instead of ``"models"`` and ``"positions"`` when the
+loaded cycle of the same run is read from the cache, :mod:`fegear.ltca.cached`).
 
 Fidelities available for gear pairs (``docs/fidelity.md``):
 
@@ -35,13 +36,15 @@ from fegear.errors import InputError
 from fegear.geometry.pair_placement import Assembly
 from fegear.io.gear_case import FIDELITIES, N_LEVELS, UNLOADED, GearCase
 from fegear.ltca import LTCAOptions, build_models, run_ltca
+from fegear.ltca.cached import cached_cycle, cycle_params
 from fegear.ltca.cycle import cycle_tca
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.results import LoadedCycle
 from fegear.pipeline.engagement import Engagement, check_clearance, check_engagement
-from fegear.pipeline.fields import MemberField, displacements
+from fegear.pipeline.fields import FIELD_CLASSES, MemberField, displacements
 from fegear.pipeline.pair import GearPair, build_pair
 from fegear.store.cache import CacheUse, record_cache_use
+from fegear.store.records import cached_object
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 from fegear.tca.cycle import cycle_result
@@ -87,6 +90,9 @@ class GearRun:
         Per position the contact ellipses of the unloaded TCA
         (:class:`fegear.tca.ellipse.EllipseAt`, None without contact; Hertz at the case's load
         on one pair).
+    cycle_key
+        The cache key of the loaded cycle (:mod:`fegear.ltca.cached`; "" for none): what its
+        displacement fields are cached under.
     """
 
     case: GearCase
@@ -99,6 +105,7 @@ class GearRun:
     engagement: Engagement | None = None
     cache: CacheUse | None = None
     ellipses: tuple[EllipseAt | None, ...] = ()
+    cycle_key: str = ""
 
     @property
     def fidelity(self) -> str:
@@ -151,6 +158,7 @@ def run_gear_case(
     workers: int | None = None,
     notify: Callable[[str], None] | None = None,
     fields: bool = True,
+    reuse: bool = True,
 ) -> GearRun:
     """Run a gear case at its (or the given) fidelity and level.
 
@@ -178,6 +186,11 @@ def run_gear_case(
         numbers only (every number of ``summary.json`` but the ``mesh`` sizes of the fields);
         :func:`with_fields` adds them later. The root stress (``case.root_stress``) is always
         computed: it is a number of the run.
+    reuse
+        Read the loaded cycle (every position) and its displacement fields from the cache when
+        the same run was made before (:mod:`fegear.ltca.cached`: keyed on the pair, the
+        installation, the torque, the options and the code); False: solve them again (the
+        cache is neither read nor written for them).
 
     Raises
     ------
@@ -189,7 +202,7 @@ def run_gear_case(
     from dataclasses import replace
 
     with record_cache_use() as used:
-        run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields)
+        run = _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields, reuse)
     return replace(run, cache=used())
 
 
@@ -206,12 +219,48 @@ def with_fields(run: GearRun, progress: Progress | None = None) -> GearRun:
     t0 = time.perf_counter()
     say("displacements", None, None)
     with record_cache_use() as used:
-        c = run.case
-        members = displacements(run.pair, run.assembly, run.cycle.models, run.cycle, run.phi2,
-                                root_stress=c.root_stress, backend=c.backend)  # fmt: skip
+        members = _member_fields(run)
     seconds = {**run.seconds, "displacements": time.perf_counter() - t0}
     cache = used() if run.cache is None else run.cache.joined(used())
     return replace(run, members=members, seconds=seconds, cache=cache)
+
+
+def _member_fields(run: GearRun) -> tuple[MemberField, ...]:
+    """The displacement fields of a loaded run (:func:`fegear.pipeline.fields.displacements`),
+    from the cache when its cycle's fields were computed before (``member_fields``, keyed on
+    the cycle's key, the root-stress switch and the solver backend); a cycle read from the
+    cache has no models: they are built (read from the cache) only when the fields are not."""
+    c = run.case
+
+    def compute() -> tuple[MemberField, ...]:
+        models = run.cycle.models
+        if models is None:  # the cycle came from the cache: its models, on its zone
+            opt = _ltca_options(c, None)
+            p = run.pair
+            models = build_models(p.pinion, p.gear, p.assembly, opt, zone=run.cycle.zone)
+        return displacements(run.pair, run.assembly, models, run.cycle, run.phi2,
+                             root_stress=c.root_stress, backend=c.backend)  # fmt: skip
+
+    if not run.cycle_key:
+        return compute()
+    params = {"cycle": run.cycle_key, "root_stress": c.root_stress, "backend": c.backend}
+    members, _ = cached_object("member_fields", params, compute, FIELD_CLASSES)
+    return tuple(members)
+
+
+def _ltca_options(case: GearCase, workers: int | None) -> LTCAOptions:
+    """The :class:`~fegear.ltca.analysis.LTCAOptions` of a case."""
+    return LTCAOptions(
+        n_positions=case.n_positions,
+        level=case.level,
+        n_teeth=case.n_teeth,
+        E_MPa=case.E_MPa,
+        nu=case.nu,
+        backend=case.backend,
+        fidelity=case.fidelity,
+        workers=workers,
+        **case.contact.as_dict(),
+    )
 
 
 def _ellipses(case: GearCase, tca, positions) -> tuple:
@@ -220,7 +269,7 @@ def _ellipses(case: GearCase, tca, positions) -> tuple:
     return ellipses(positions, tca.asm.axis1(), T1, tca.opt.paint_mm, case.E_MPa, case.nu)
 
 
-def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields) -> GearRun:
+def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields, reuse):
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
     seconds: dict[str, float] = {}
@@ -249,17 +298,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, field
             ellipses=ell,
         )  # fmt: skip
 
-    opt = LTCAOptions(
-        n_positions=case.n_positions,
-        level=case.level,
-        n_teeth=case.n_teeth,
-        E_MPa=case.E_MPa,
-        nu=case.nu,
-        backend=case.backend,
-        fidelity=case.fidelity,
-        workers=workers,
-        **case.contact.as_dict(),
-    )
+    opt = _ltca_options(case, workers)
     t0 = time.perf_counter()
     tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
     eng = check_engagement(case, pair, tca, positions, clearance, workers)  # before the FE work
@@ -267,25 +306,34 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, field
     for w in eng.warnings:
         (notify or log.warning)(w)
     seconds["checks"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    say("models", None, None)
-    models = build_models(pair.pinion, pair.gear, pair.assembly, opt)
-    seconds["models"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    say("positions", 0, case.n_positions)
-    cycle = run_ltca(
-        pair.pinion,
-        pair.gear,
-        pair.assembly,
-        case.torque2_Nmm,
-        opt,
-        models=models,
-        progress=lambda i, n: say("positions", i, n),
-    )
-    seconds["positions"] = time.perf_counter() - t0
+
+    def solve() -> LoadedCycle:
+        t0 = time.perf_counter()
+        say("models", None, None)
+        models = build_models(pair.pinion, pair.gear, pair.assembly, opt)
+        seconds["models"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        say("positions", 0, case.n_positions)
+        cycle = run_ltca(
+            pair.pinion,
+            pair.gear,
+            pair.assembly,
+            case.torque2_Nmm,
+            opt,
+            models=models,
+            progress=lambda i, n: say("positions", i, n),
+        )
+        seconds["positions"] = time.perf_counter() - t0
+        return cycle
+
+    params = cycle_params(pair.pinion, pair.gear, pair.assembly, case.torque2_Nmm, opt)
+    cycle, key, hit = cached_cycle(params, solve, reuse)
+    if hit:  # every position read back: no models, no solve
+        seconds["cycle_read"] = cycle.seconds["read"]
+        say("cached", None, None)
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng,
-                  ellipses=ell)  # fmt: skip
+                  ellipses=ell, cycle_key=key if reuse else "")  # fmt: skip
     if fields or case.root_stress:  # else the numbers only: the fields when written
         return with_fields(run, say)
     return run

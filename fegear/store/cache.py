@@ -297,6 +297,10 @@ _MESH_DEPS = ("gmsh", "meshio", "numpy", "scipy")
 _FE_DEPS = (*_MESH_DEPS, "scikit-fem")
 _TCA_CODE = ("fegear.tca", "fegear.geometry", "fegear.mechanics.hertz_closed_form")
 _TCA = Producer(_TCA_CODE, ("numpy", "scipy"))
+_CYCLE_CODE = (
+    *_MESH_CODE, "fegear.fem", "fegear.linalg", "fegear.mechanics", "fegear.tca", "fegear.ltca",
+    "fegear.store.records",
+)  # fmt: skip
 
 #: The producer of every kind of artefact (a kind not listed here cannot be cached).
 PRODUCERS: Mapping[str, Producer] = MappingProxyType(
@@ -321,6 +325,12 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "phase": _TCA,
         "contact_path": _TCA,
         "handover": _TCA,
+        # a loaded cycle, every position solved (fegear.ltca.cached), and the displacement
+        # fields of a run of it (fegear.pipeline.fields): everything they are computed with
+        "cycle": Producer(_CYCLE_CODE, (*_FE_DEPS, "threadpoolctl")),
+        "member_fields": Producer(
+            (*_CYCLE_CODE, "fegear.pipeline.fields"), (*_FE_DEPS, "threadpoolctl")
+        ),
         # the synthesized spiral bevel pair (fegear.pipeline.pair)
         "bevel_pair": Producer(("fegear.geometry",), ("numpy", "scipy")),
         # the face gear's undercut/pointing limits and fillet-limit tables (fegear.pipeline.pair)

@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
 from fegear.store.cache import cached_record
+from fegear.store.records import load_arrays, save_arrays
 
 from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
@@ -65,41 +65,6 @@ def pair_key(pinion, gear, assembly: Assembly, options: TCAOptions) -> dict[str,
         "assembly": _assembly_key(assembly),
         "options": options,
     }
-
-
-def save_arrays(path: Path, arrays: dict[str, np.ndarray]) -> dict[str, list]:
-    """Write ``arrays`` at ``path`` as an uncompressed ``.npz`` of one flat array per dtype (a
-    TCA of 25 positions has ~1000 small arrays: one ``.npz`` member each would take 0.15 s to
-    read); returns the index ``{name: [member, offset, shape]}`` that :func:`load_arrays` needs
-    (kept in the entry's JSON record)."""
-    members: dict[str, str] = {}  # dtype.str -> member name
-    parts: dict[str, list[np.ndarray]] = {}
-    sizes: dict[str, int] = {}
-    index: dict[str, list] = {}
-    for name, arr in arrays.items():
-        arr = np.asarray(arr)
-        if arr.dtype.kind not in "biuf":
-            raise TypeError(f"array {name!r}: dtype {arr.dtype} (numbers or booleans only)")
-        member = members.setdefault(arr.dtype.str, f"a{len(members)}")
-        index[name] = [member, sizes.get(member, 0), list(arr.shape)]
-        sizes[member] = sizes.get(member, 0) + arr.size
-        parts.setdefault(member, []).append(arr.ravel())
-    blobs = {m: np.concatenate(p) for m, p in parts.items()}
-    with open(path, "wb") as fh:
-        np.savez(fh, **blobs)
-    return index
-
-
-def load_arrays(path: Path, index: dict[str, list]) -> dict[str, np.ndarray]:
-    """The arrays of :func:`save_arrays` (``index`` is what it returned), read without pickles:
-    each a copy of its slice of the flat arrays, with its dtype and shape."""
-    with np.load(path, allow_pickle=False) as z:
-        blobs = {m: z[m] for m in z.files}
-    out = {}
-    for name, (member, offset, shape) in index.items():
-        size = int(np.prod(shape, dtype=np.int64))
-        out[name] = blobs[member][offset : offset + size].reshape(shape).copy()
-    return out
 
 
 def cached_phase(pinion, gear, assembly: Assembly, options: TCAOptions) -> float:

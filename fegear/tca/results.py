@@ -10,7 +10,6 @@ masked by a boolean array next to them.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -18,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..mechanics.hertz_closed_form import HertzPoint
+from ..store import records
 from .ellipse import ContactCurvature
 
 __all__ = [
@@ -259,69 +259,26 @@ class CycleResult:
 
 # ------------------------------------------------------------------ plain-data records
 #: The classes a record (:func:`to_record`) may hold, by name.
-_RECORD_CLASSES = {
-    c.__name__: c
-    for c in (PositionResult, SeparationGrid, ContactEllipseAt, ContactCurvature, HertzPoint)
-}
+_RECORD_CLASSES = records.registry(
+    PositionResult, SeparationGrid, ContactEllipseAt, ContactCurvature, HertzPoint
+)
 
 
 def to_record(obj: object, arrays: dict[str, np.ndarray], key: str) -> object:
     """``obj`` as plain JSON data, its arrays put in ``arrays`` (for ``np.savez``), for the
-    on-disk TCA cache (:mod:`fegear.tca.cached`): no pickle, and :func:`from_record` gives back
-    an equal object bit for bit.
-
-    Handles ``None``, ``bool``, ``int``, ``float`` (JSON writes a float by its ``repr``, which
-    reads back exactly), ``str``; numpy arrays of numbers or booleans and numpy scalars (stored
-    in ``arrays`` under names starting with ``key``, dtype and shape kept); tuples and lists;
-    dicts with ``str`` keys; the result dataclasses of this module and
-    :class:`~fegear.mechanics.hertz_closed_form.HertzPoint`.
+    on-disk TCA cache (:mod:`fegear.tca.cached`): :func:`fegear.store.records.to_record` with
+    the result dataclasses of this module and
+    :class:`~fegear.mechanics.hertz_closed_form.HertzPoint`; :func:`from_record` gives back an
+    equal object bit for bit.
 
     Raises
     ------
     TypeError
         Anything else (naming its type and ``key``).
     """
-    if obj is None or type(obj) in (bool, int, float, str):
-        return obj
-    if isinstance(obj, (np.ndarray, np.generic)):
-        arr = np.asarray(obj)
-        if arr.dtype.kind not in "biuf":
-            raise TypeError(f"TCA record: {key} has dtype {arr.dtype} (numbers or booleans only)")
-        if key in arrays:
-            raise ValueError(f"TCA record: two arrays named {key!r}")
-        arrays[key] = arr
-        return {"npz": key, "scalar": isinstance(obj, np.generic)}
-    if isinstance(obj, tuple):
-        return {"tuple": [to_record(v, arrays, f"{key}.{i}") for i, v in enumerate(obj)]}
-    if isinstance(obj, list):
-        return [to_record(v, arrays, f"{key}.{i}") for i, v in enumerate(obj)]
-    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
-        return {"dict": {k: to_record(v, arrays, f"{key}.{k}") for k, v in obj.items()}}
-    cls = type(obj)
-    if _RECORD_CLASSES.get(cls.__name__) is cls:
-        fields = {
-            f.name: to_record(getattr(obj, f.name), arrays, f"{key}.{f.name}")
-            for f in dataclasses.fields(obj)
-        }
-        return {"dataclass": cls.__name__, "fields": fields}
-    raise TypeError(f"TCA record: {key} is a {cls.__module__}.{cls.__qualname__}")
+    return records.to_record(obj, arrays, key, _RECORD_CLASSES)
 
 
 def from_record(doc: object, arrays: Mapping[str, np.ndarray]) -> object:
     """The object of :func:`to_record` (``arrays``: its arrays, e.g. an ``np.load`` of them)."""
-    if doc is None or isinstance(doc, (bool, int, float, str)):
-        return doc
-    if isinstance(doc, list):
-        return [from_record(v, arrays) for v in doc]
-    if isinstance(doc, dict):
-        if "npz" in doc:
-            arr = arrays[doc["npz"]]
-            return arr[()] if doc["scalar"] else arr
-        if "tuple" in doc:
-            return tuple(from_record(v, arrays) for v in doc["tuple"])
-        if "dict" in doc:
-            return {k: from_record(v, arrays) for k, v in doc["dict"].items()}
-        if "dataclass" in doc:
-            cls = _RECORD_CLASSES[doc["dataclass"]]
-            return cls(**{k: from_record(v, arrays) for k, v in doc["fields"].items()})
-    raise ValueError(f"TCA record: not a record: {str(doc)[:80]}")
+    return records.from_record(doc, arrays, _RECORD_CLASSES)
