@@ -10,6 +10,8 @@ where marked, once more on the cache it left (warm):
 * ``sweep``: ``fegear sweep cases/face_gear_nominal.toml --grid
   errors.dgamma_deg=-0.02:0.02:5`` (five shaft-angle errors, one process): its wall time, and
   the cache size after each item (the growth per variant after the first);
+* ``sweep2``: the same sweep with ``--workers 2`` (the first item alone, then two side by
+  side);
 * ``dE``, ``dA1``, ``dA2``, ``dgamma``: ``python cases/face_gear_<error>.py`` (three values each
   through the Python API, ``hybrid`` level 0).
 
@@ -54,6 +56,21 @@ JOBS = {
             "--out",
             "{work}/sweep",
             "-q",
+        ],
+        False,
+    ),  # fmt: skip
+    "sweep2": (
+        FEGEAR
+        + [
+            "sweep",
+            str(NOMINAL),
+            "--grid",
+            "errors.dgamma_deg=-0.02:0.02:5",
+            "--out",
+            "{work}/sweep",
+            "-q",
+            "--workers",
+            "2",
         ],
         False,
     ),  # fmt: skip
@@ -147,7 +164,7 @@ def run_job(name: str) -> dict:
     with tempfile.TemporaryDirectory(prefix="fegear_study_") as tmp:
         work, cache = Path(tmp) / "work", Path(tmp) / "cache"
         work.mkdir()
-        cold = _one(argv, work, cache, name == "sweep")
+        cold = _one(argv, work, cache, name.startswith("sweep"))
         out = {"job": name, "cold": cold}
         if warm and cold["exit"] == 0:
             out["warm"] = _one(argv, work, cache, False)
@@ -217,7 +234,8 @@ def main() -> None:
         "warm on the cache it left; seed face gear, `hybrid` level 0, 25 positions):\n\n"
         + table(rows)
         + "\n\n`sweep`: `fegear sweep cases/face_gear_nominal.toml --grid "
-        "errors.dgamma_deg=-0.02:0.02:5` (one process, items one after the other); growth per "
+        "errors.dgamma_deg=-0.02:0.02:5` (one process, items one after the other; `sweep2`: "
+        "`--workers 2`, the first item alone, then two side by side); growth per "
         "variant: the cache size after the last item minus after the first, over the items "
         "between. `dE` … `dgamma`: `python cases/face_gear_<error>.py` (three values each). "
         "Load before: the 1-minute load average before the cold / warm run; others' CPU: the CPU "

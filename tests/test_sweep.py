@@ -373,3 +373,23 @@ def test_leftovers_of_a_killed_run_are_cleaned(tmp_path):
     gone = _clean_tmp(tmp_path)
     assert sorted(gone) == [".item.ab12.tmp", ".sweep.x7k2.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == [".sweep.lock", "done_item"]
+
+
+def test_with_two_workers_the_first_item_builds_what_the_others_read(fzg3, tmp_path,
+                                                                      monkeypatch):  # fmt: skip
+    """``--workers 2`` from an empty cache: the first item runs alone and builds the sector
+    meshes and operators; the two after it, side by side, read them (each item's own cache
+    records in its summary.json): items started together would each build them."""
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "sw"
+    grid = "errors.da_mm=0,0.01,0.02"
+    assert main(["sweep", str(fzg3), "--grid", grid, "--out", str(out), "--workers", "2",
+                 "-q"]) == 0  # fmt: skip
+    names = [it.name for it in build_items([str(fzg3)], [grid])]
+    _check_items(out, names)
+    built = [json.loads((out / n / "summary.json").read_text())["cache"]["built"] for n in names]
+    hits = [json.loads((out / n / "summary.json").read_text())["cache"]["hits"] for n in names]
+    assert "mesh" in built[0] and "compliance" in built[0], built[0]
+    for b, h in zip(built[1:], hits[1:], strict=True):
+        assert "mesh" not in b and "compliance" not in b, b
+        assert h.get("mesh") == 2 and h.get("compliance", 0) >= 2, h

@@ -613,7 +613,9 @@ def run_sweep(
     out
         Sweep folder; item ``k`` goes to ``out/<name>/``.
     workers
-        Local worker processes (ignored with ``scheduler``).
+        Local worker processes (ignored with ``scheduler``); with more than one, the first item
+        to compute runs alone first (it builds the sector meshes and operators the others then
+        read), the others side by side.
     scheduler
         Address of a Dask distributed scheduler (``tcp://host:8786``); Dask is imported only
         then.
@@ -696,6 +698,19 @@ def _execute(
         finally:
             client.close()
         return
+    if workers > 1 and len(todo) > 1:
+        # the first item alone, on every core: it builds the sector meshes and operators the
+        # others read (items started together would each build them); then the others
+        # side by side, each reading them from the cache
+        yield from _local(todo[:1], out, 1, cache_root)
+        yield from _local(todo[1:], out, workers, cache_root)
+    else:
+        yield from _local(todo, out, workers, cache_root)
+
+
+def _local(todo: list[SweepItem], out: Path, workers: int, cache_root: str) -> Iterator[ItemResult]:
+    """Run ``todo`` on a pool of ``min(workers, len(todo))`` local processes, the cores shared
+    among them; yield each result as it finishes."""
     n_pool = min(workers, len(todo))
     pool = _local_pool(n_pool)
     # the cores each item may use ($FEGEAR_WORKERS, if set, decides in the item's process)
