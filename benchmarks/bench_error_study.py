@@ -44,36 +44,12 @@ ROOT = HERE.parent
 RESULTS = HERE / "results"
 NOMINAL = ROOT / "cases" / "face_gear_nominal.toml"
 FEGEAR = [sys.executable, "-m", "fegear.cli"]
+SWEEP = FEGEAR + ["sweep", str(NOMINAL), "--grid", "errors.dgamma_deg=-0.02:0.02:5",
+                  "--out", "{work}/sweep", "-q"]  # fmt: skip
 JOBS = {
     "run": (FEGEAR + ["run", str(NOMINAL), "-q", "--out", "{work}/out"], True),
-    "sweep": (
-        FEGEAR
-        + [
-            "sweep",
-            str(NOMINAL),
-            "--grid",
-            "errors.dgamma_deg=-0.02:0.02:5",
-            "--out",
-            "{work}/sweep",
-            "-q",
-        ],
-        False,
-    ),  # fmt: skip
-    "sweep2": (
-        FEGEAR
-        + [
-            "sweep",
-            str(NOMINAL),
-            "--grid",
-            "errors.dgamma_deg=-0.02:0.02:5",
-            "--out",
-            "{work}/sweep",
-            "-q",
-            "--workers",
-            "2",
-        ],
-        False,
-    ),  # fmt: skip
+    "sweep": (SWEEP, False),
+    "sweep2": (SWEEP + ["--workers", "2"], False),
     **{
         e: ([sys.executable, str(ROOT / "cases" / f"face_gear_{e}.py")], True)
         for e in ("dE", "dA1", "dA2", "dgamma")
