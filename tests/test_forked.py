@@ -104,3 +104,34 @@ def test_nested_cache_records_each_count_their_own():
         value, lookups = recorded(lambda: 7)
     assert value == 7 and lookups.pid == os.getpid() and not lookups.hits
     assert outer().hits == {} and outer().built == {}
+
+
+_MESH_AFTER_GMSH = """
+import sys
+from fegear.case_files import load_case
+from fegear.ltca.analysis import _sector_meshes
+from fegear.mesh.sector import sector_mesh
+from fegear.pipeline.pair import build_pair
+
+pair = build_pair(load_case(sys.argv[1]))
+sector_mesh(pair.pinion, 3, 0)  # gmsh started in this process
+meshes = _sector_meshes((pair.pinion, pair.gear), ("drive", "drive"), 5, 0, workers=2)
+print(len(meshes), meshes[1].tets.shape[0] > 0)
+"""
+
+
+def test_a_process_that_has_meshed_meshes_both_sectors_itself(tmp_path):
+    """gmsh cannot mesh in a process forked after gmsh ran in its parent (the child's mesh
+    generation waits forever on threads the fork did not copy): a process that has meshed
+    before makes both sectors itself, and finishes (in a fresh process with a cold cache, so
+    that both sectors are meshed; the timeout is what a hang would hit, ~10x the work)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    case = Path(__file__).resolve().parents[1] / "cases" / "fzg_spur.toml"
+    env = dict(os.environ, FEGEAR_CACHE=str(tmp_path / "cache"))
+    res = subprocess.run([sys.executable, "-c", _MESH_AFTER_GMSH, str(case)], env=env,
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.split() == ["2", "True"]

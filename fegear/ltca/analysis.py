@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fegear.errors import InputError
-from fegear.forked import fork_map, process_count
+from fegear.forked import apart, process_count
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.model import (
     MemberModel,
@@ -24,7 +24,9 @@ from fegear.ltca.model import (
 )
 from fegear.ltca.position import solve_position
 from fegear.ltca.zone import ContactZone, contact_zone
-from fegear.mesh.sector import FINE, sector_mesh
+from fegear.mesh import gmsh_session
+from fegear.mesh.sector import FINE, mesh_sizes, sector_mesh
+from fegear.mesh.sector_geometry import sector_frame
 from fegear.options import ContactOptions
 from fegear.store.cache import count_lookups, recorded
 from fegear.tca import TCAOptions
@@ -163,23 +165,35 @@ def cycle_zone(
     )
 
 
-def _sector_meshes(members, sides, n_teeth: int, level: int, workers: int | None) -> list:
-    """Both members' sector meshes (:func:`fegear.mesh.sector.sector_mesh`), the pinion's here
-    and the gear's in a forked process at the same time (:func:`fegear.forked.fork_map`) when
-    two processes are allowed (``workers``): gmsh meshes on one thread (deterministic meshes),
-    so two members meshed cold take the time of the slower one. The mesh made in the other
-    process is the one made here (same code and inputs, the cache entry it writes is read back
-    the same); its cache lookups are counted as this run's (:func:`fegear.store.cache.recorded`).
-    """
-    parts = list(zip(members, sides, strict=True))
+def _sector_meshes_apart(members, sides, n_teeth: int, level: int, workers: int | None) -> list:
+    """Both members' sector meshes (:func:`fegear.mesh.sector.sector_mesh`) as two functions
+    that return them: the gear's is started now in a forked process when two processes are
+    allowed (``workers``; :func:`fegear.forked.apart`), the pinion's is made here when asked
+    for, so that what is done with it (its operator) runs while the gear is meshed. gmsh meshes
+    on one thread (deterministic meshes). The mesh made in the other process is the one made
+    here (same code and inputs, the cache entry it writes is read back the same); its cache
+    lookups are counted as this run's (:func:`fegear.store.cache.recorded`). A process that
+    has run gmsh before meshes both here (:func:`fegear.mesh.gmsh_session.started_here`)."""
 
-    def one(part):
-        return recorded(lambda: sector_mesh(part[0], n_teeth, level, side=part[1]))
+    def one(i: int):
+        return recorded(lambda: sector_mesh(members[i], n_teeth, level, side=sides[i]))
 
-    done = fork_map(one, parts, fork=process_count(workers, len(parts)) > 1)
-    for _, lookups in done:
+    # a process that has run gmsh cannot mesh in a fork of itself (gmsh_session.started_here)
+    fork = process_count(workers, 2) > 1 and not gmsh_session.started_here()
+    later = apart(lambda: one(1), fork)
+
+    def get(i: int):
+        sm, lookups = one(0) if i == 0 else later()
         count_lookups(lookups)
-    return [sm for sm, _ in done]
+        return sm
+
+    return [lambda: get(0), lambda: get(1)]
+
+
+def _sector_meshes(members, sides, n_teeth: int, level: int, workers: int | None) -> list:
+    """Both members' sector meshes (:func:`_sector_meshes_apart`), the gear's made in a forked
+    process while the pinion's is made here."""
+    return [get() for get in _sector_meshes_apart(members, sides, n_teeth, level, workers)]
 
 
 def build_models(
@@ -201,24 +215,31 @@ def build_models(
         zone = cycle_zone(pinion, gear, assembly, options)
     n = zone.n_teeth
     sides = (assembly.side1, assembly.side2)
-    sectors = _sector_meshes((pinion, gear), sides, n, options.level, options.workers)
-    h = max(float(sm.parameters["h_fine_mm"]) for sm in sectors)
-    module = min(float(sm.parameters["h_fine_mm"]) / FINE[options.level] for sm in sectors)
+    # the fine element size of each sector, as its mesh records it (mesh_sizes of its frame's
+    # module), known before the meshes: the pinion's operator is built while the gear is meshed
+    fine = [mesh_sizes(sector_frame(m).module, options.level)[0] for m in (pinion, gear)]
+    h = max(fine)
+    module = min(f / FINE[options.level] for f in fine)
     depth = layer = fidelity_of(options.fidelity).layer_depth(h, module, options)
     loaded = tuple(range(1, n - 1)) if n >= 3 else tuple(range(n))
-    models = [
-        build_member_model(
-            member.name,
+
+    def model(i: int, sm) -> MemberModel:
+        assert float(sm.parameters["h_fine_mm"]) == fine[i], "the size the layer was made for"
+        return build_member_model(
+            (pinion, gear)[i].name,
             sm,
-            side,
+            sides[i],
             options.E_MPa,
             options.nu,
             options.backend,
             layer_mm=layer,
             teeth=loaded,
         )
-        for member, side, sm in zip((pinion, gear), sides, sectors, strict=True)
-    ]
+
+    # the gear's sector meshed in a second process while this one meshes the pinion's and
+    # builds its operator; one process: one after the other (the same meshes and operators)
+    meshes = _sector_meshes_apart((pinion, gear), sides, n, options.level, options.workers)
+    models = [model(i, get()) for i, get in enumerate(meshes)]
     cell = options.cell_mm if options.cell_mm is not None else h
     return MemberModels(
         models[0],

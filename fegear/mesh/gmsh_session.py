@@ -25,13 +25,30 @@ import tempfile
 import threading
 from collections.abc import Iterator
 
-__all__ = ["initialize", "native_output_to_log"]
+__all__ = ["initialize", "native_output_to_log", "started_here"]
+
+#: Whether gmsh was started in this process or in the process it was forked from (a fork
+#: copies the flag with the rest of the memory; see :func:`started_here`).
+_STARTED = [False]
+
+
+def started_here() -> bool:
+    """Whether gmsh was started (:func:`initialize`) in this process before, or in the process
+    it was forked from.
+
+    A process forked after that cannot mesh: gmsh's mesh generation in the child waits forever
+    on the threads of the parent's gmsh, which the fork did not copy (measured: a sector meshed
+    in the parent, then another in a forked child: ``gmsh::model::mesh::generate`` blocked in
+    ``pthread_cond_wait``, no CPU used). Work that meshes in a forked process
+    (:func:`fegear.ltca.analysis.build_models`) meshes here instead when this is true."""
+    return _STARTED[0]
 
 
 def initialize() -> None:
     """``gmsh.initialize(interruptible=False)``, then SIGPIPE as it was before."""
     import gmsh
 
+    _STARTED[0] = True
     main = threading.current_thread() is threading.main_thread()
     before = signal.getsignal(signal.SIGPIPE) if main else None
     gmsh.initialize(interruptible=False)
