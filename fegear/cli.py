@@ -261,6 +261,9 @@ def _run_gear(args: argparse.Namespace, case) -> int:
             bar = "#" * int(20 * i / n)
             say(f"    position {i:3d}/{n} [{bar:<20s}] {now - stage_t['t']:6.1f} s")
             return
+        if stage == "cached":  # the fields of the same run are read back too
+            k = len(stages)
+            labels["writing"] = f"[{k}/{k}] outputs (the displacement fields read back if cached)"
         say(f"{labels.get(stage, stage)} ...  ({now - t_start:.1f} s elapsed)")
         stage_t["t"] = now
 
