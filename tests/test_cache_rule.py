@@ -22,10 +22,10 @@ import pytest
 from fegear.geometry import InvoluteDesign, InvoluteMember
 from fegear.geometry.pair_placement import InstallationErrors, involute_assembly
 from fegear.store import cache as fcache
+from fegear.store import records as frecords
 from fegear.tca import TCAOptions
-from fegear.tca import cached as tcached
 from fegear.tca.cached import cached_tca
-from fegear.tca.results import to_record
+from fegear.tca.results import RECORD_CLASSES
 
 PACKAGE = Path(__file__).resolve().parents[1] / "fegear"
 PINION = InvoluteMember(
@@ -230,7 +230,7 @@ def test_tca_round_trip_is_bitwise_and_holds_no_pickle(private_cache):
 
 def test_a_record_of_an_unknown_object_is_refused():
     with pytest.raises(TypeError, match="object"):
-        to_record({"x": object()}, {}, "s")
+        frecords.to_record({"x": object()}, {}, "s", RECORD_CLASSES)
 
 
 # --------------------------------------------------------------------------------------------
@@ -243,17 +243,17 @@ class _Cut(Exception):
 
 
 def test_an_interrupted_tca_write_leaves_no_trusted_entry(private_cache, monkeypatch):
-    real = tcached.save_arrays
+    real = frecords.save_arrays
 
     def half(path, arrays):  # writes part of the file, then the run dies
         Path(path).write_bytes(b"PK\x03\x04 half an npz")
         raise _Cut
 
-    monkeypatch.setattr(tcached, "save_arrays", half)
+    monkeypatch.setattr(frecords, "save_arrays", half)
     with pytest.raises(_Cut):
         cached_tca(PINION, GEAR, _asm(), OPT, PHI1)
     assert list((private_cache / "tca").iterdir()) == []  # the temporary file is gone too
-    monkeypatch.setattr(tcached, "save_arrays", real)
+    monkeypatch.setattr(frecords, "save_arrays", real)
     again = cached_tca(PINION, GEAR, _asm(), OPT, PHI1)
     assert not again.cache_hit
     assert cached_tca(PINION, GEAR, _asm(), OPT, PHI1).cache_hit

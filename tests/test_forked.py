@@ -72,18 +72,18 @@ def test_sectors_meshed_side_by_side_are_the_meshes_made_here_and_counted_here()
     import numpy as np
 
     from fegear.case_files import load_case
-    from fegear.ltca.analysis import _sector_meshes
+    from fegear.ltca.analysis import _sector_meshes_apart
     from fegear.pipeline.pair import build_pair
     from fegear.store.cache import record_cache_use
 
     pair = build_pair(load_case(Path(__file__).resolve().parents[1] / "cases" / "fzg_spur.toml"))
     members, sides = (pair.pinion, pair.gear), ("drive", "drive")
     with record_cache_use() as used:
-        apart_ = _sector_meshes(members, sides, 5, 0, workers=2)
+        apart_ = [get() for get in _sector_meshes_apart(members, sides, 5, 0, workers=2)]
     use = used()
     assert sum(use.hits.values()) + sum(use.built.values()) == 2, use  # one lookup per member
     with record_cache_use() as again:
-        here = _sector_meshes(members, sides, 5, 0, workers=1)
+        here = [get() for get in _sector_meshes_apart(members, sides, 5, 0, workers=1)]
     assert again().hits == {"mesh": 2} and not again().built  # what the child built is cached
     for a, b in zip(apart_, here, strict=True):
         assert a.path == b.path and np.array_equal(a.points, b.points)
@@ -109,13 +109,14 @@ def test_nested_cache_records_each_count_their_own():
 _MESH_AFTER_GMSH = """
 import sys
 from fegear.case_files import load_case
-from fegear.ltca.analysis import _sector_meshes
+from fegear.ltca.analysis import _sector_meshes_apart
 from fegear.mesh.sector import sector_mesh
 from fegear.pipeline.pair import build_pair
 
 pair = build_pair(load_case(sys.argv[1]))
 sector_mesh(pair.pinion, 3, 0)  # gmsh started in this process
-meshes = _sector_meshes((pair.pinion, pair.gear), ("drive", "drive"), 5, 0, workers=2)
+getters = _sector_meshes_apart((pair.pinion, pair.gear), ("drive", "drive"), 5, 0, workers=2)
+meshes = [get() for get in getters]
 print(len(meshes), meshes[1].tets.shape[0] > 0)
 """
 

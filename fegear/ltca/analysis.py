@@ -190,12 +190,6 @@ def _sector_meshes_apart(members, sides, n_teeth: int, level: int, workers: int 
     return [lambda: get(0), lambda: get(1)]
 
 
-def _sector_meshes(members, sides, n_teeth: int, level: int, workers: int | None) -> list:
-    """Both members' sector meshes (:func:`_sector_meshes_apart`), the gear's made in a forked
-    process while the pinion's is made here."""
-    return [get() for get in _sector_meshes_apart(members, sides, n_teeth, level, workers)]
-
-
 def build_models(
     pinion, gear, assembly, options: LTCAOptions, zone: ContactZone | None = None
 ) -> MemberModels:

@@ -20,7 +20,6 @@ written by its ``repr``, so a hit gives back the positions bit for bit.
 
 from __future__ import annotations
 
-import logging
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -39,8 +38,6 @@ from fegear.store.records import cached_object, registry
 from fegear.tca.cached import pair_key
 
 __all__ = ["CachedCycle", "cached_cycle", "cycle_params"]
-
-log = logging.getLogger(__name__)
 
 #: The classes a cycle record holds.
 CLASSES = registry(

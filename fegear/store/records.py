@@ -169,11 +169,13 @@ def cached_object(
     make: Callable[[], T],
     classes: Mapping[str, type],
     stored: Callable[[T], object] = lambda obj: obj,
+    restore: Callable[[object], T] = lambda data: data,  # type: ignore[assignment,return-value]
 ) -> tuple[T, bool]:
-    """``(obj, hit)``: the object of ``params`` read from the cache entry of ``kind``
+    """``(obj, hit)``: the object of ``params`` from the cache entry of ``kind``
     (:func:`fegear.store.cache.cached_record`), else ``make()``, stored as ``stored(obj)`` (e.g.
     without what must not be kept) in a record of this module: a ``.npz`` of its arrays
-    (:func:`save_arrays`) and its JSON data (:func:`to_record` with ``classes``)."""
+    (:func:`save_arrays`) and its JSON data (:func:`to_record` with ``classes``); a hit is
+    ``restore`` of what was stored (default: it as it is)."""
     made: list[T] = []
 
     def build(entry) -> dict[str, object]:
@@ -182,11 +184,11 @@ def cached_object(
         arrays: dict[str, np.ndarray] = {}
         doc = to_record(stored(obj), arrays, kind, classes)
         index: dict[str, list] = {}
-        entry.write(".npz", lambda p: index.update(save_arrays(p, arrays)))
+        entry.write(".npz", lambda p: index.update(save_arrays(p, arrays)))  # data first
         return {"object": doc, "index": index}
 
     entry, record, hit = cached_record(kind, params, build)
     if not hit:
         return made[0], False
     arrays = load_arrays(entry.path(".npz"), record["index"])
-    return from_record(record["object"], arrays, classes), True
+    return restore(from_record(record["object"], arrays, classes)), True

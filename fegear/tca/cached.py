@@ -14,11 +14,11 @@ scipy versions
 (:data:`fegear.store.cache.PRODUCERS`), so a change of the code that produces the positions
 invalidates the entry by itself.
 
-The entry (:func:`fegear.store.cache.cached_record`) is plain data, no pickle: a ``.npz`` of the
+The entry (:func:`fegear.store.records.cached_object`) is plain data, no pickle: a ``.npz`` of the
 arrays (read with ``allow_pickle=False``) and the JSON record, written last, of the phase, the
 :class:`~fegear.tca.results.PositionResult` tuple and the TCA's precomputed state
-(:meth:`~fegear.tca.TCA.state_record`) with their numbers (:func:`~fegear.tca.results.to_record`:
-a float is written by its ``repr``, so a hit gives back the positions bit for bit).
+(:meth:`~fegear.tca.TCA.state_record`) with their numbers (a float is written by its ``repr``,
+so a hit gives back the positions bit for bit).
 """
 
 from __future__ import annotations
@@ -30,15 +30,15 @@ from typing import NamedTuple
 import numpy as np
 
 from fegear.store.cache import cached_record
-from fegear.store.records import load_arrays, save_arrays
+from fegear.store.records import cached_object
 
 from ..geometry.pair_placement import Assembly
 from .core import TCA, TCAOptions
 from .cycle import reference_phase
 from .parallel import positions as parallel_positions
-from .results import PositionResult, from_record, to_record
+from .results import RECORD_CLASSES, PositionResult
 
-__all__ = ["CachedTCA", "cached_phase", "cached_tca", "load_arrays", "save_arrays"]
+__all__ = ["CachedTCA", "cached_phase", "cached_tca"]
 
 log = logging.getLogger(__name__)
 
@@ -102,31 +102,21 @@ def cached_tca(
     """
     phi1 = np.atleast_1d(np.asarray(phi1, dtype=float))
     params = {**pair_key(pinion, gear, assembly, options), "phi1": phi1}
-    box: dict[str, object] = {}
     phase2 = cached_phase(pinion, gear, assembly, options)  # one small record, shared by errors
 
-    def build(entry) -> dict[str, object]:
-        asm = assembly.with_phase2(phase2)
-        tca = TCA(pinion, gear, asm, options)
-        positions = tuple(parallel_positions(tca, phi1, workers=workers))
-        box["tca"], box["positions"] = tca, positions
-        arrays: dict[str, np.ndarray] = {}
-        record = {
-            "phase2": float(asm.phase2),
-            "positions": to_record(positions, arrays, "positions"),
-            "state": to_record(tca.state_record(), arrays, "state"),
-        }
-        index: dict[str, list] = {}
-        entry.write(".npz", lambda tmp: index.update(save_arrays(tmp, arrays)))  # data first
-        return {**record, "arrays": index}
+    def make() -> CachedTCA:
+        tca = TCA(pinion, gear, assembly.with_phase2(phase2), options)
+        return CachedTCA(tca, tuple(parallel_positions(tca, phi1, workers=workers)), False)
 
-    entry, record, hit = cached_record("tca", params, build)
-    if not hit:
-        return CachedTCA(box["tca"], box["positions"], False)  # type: ignore[arg-type]
-    arrays = load_arrays(entry.path(".npz"), record["arrays"])
-    positions = from_record(record["positions"], arrays)
-    state = from_record(record["state"], arrays)
-    asm = assembly.with_phase2(float(record["phase2"]))
-    tca = TCA.from_state_record(state, pinion, gear, asm, options)  # type: ignore[arg-type]
-    log.info("TCA positions read from the cache (%d)", len(positions))  # type: ignore[arg-type]
-    return CachedTCA(tca, tuple(positions), True)  # type: ignore[arg-type]
+    def stored(made: CachedTCA) -> dict[str, object]:
+        tca = made.tca
+        return {"phase2": float(tca.asm.phase2), "positions": made.positions,
+                "state": tca.state_record()}  # fmt: skip
+
+    def restore(data) -> CachedTCA:
+        asm = assembly.with_phase2(float(data["phase2"]))
+        tca = TCA.from_state_record(data["state"], pinion, gear, asm, options)
+        log.info("TCA positions read from the cache (%d)", len(data["positions"]))
+        return CachedTCA(tca, tuple(data["positions"]), True)
+
+    return cached_object("tca", params, make, RECORD_CLASSES, stored, restore)[0]

@@ -10,7 +10,6 @@ masked by a boolean array next to them.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,8 +25,7 @@ __all__ = [
     "PositionResult",
     "CycleResult",
     "ARCSEC",
-    "from_record",
-    "to_record",
+    "RECORD_CLASSES",
 ]
 
 Array = NDArray[np.float64]
@@ -258,27 +256,7 @@ class CycleResult:
 
 
 # ------------------------------------------------------------------ plain-data records
-#: The classes a record (:func:`to_record`) may hold, by name.
-_RECORD_CLASSES = records.registry(
+#: The classes a TCA cache record holds (:mod:`fegear.store.records`, :mod:`fegear.tca.cached`).
+RECORD_CLASSES = records.registry(
     PositionResult, SeparationGrid, ContactEllipseAt, ContactCurvature, HertzPoint
 )
-
-
-def to_record(obj: object, arrays: dict[str, np.ndarray], key: str) -> object:
-    """``obj`` as plain JSON data, its arrays put in ``arrays`` (for ``np.savez``), for the
-    on-disk TCA cache (:mod:`fegear.tca.cached`): :func:`fegear.store.records.to_record` with
-    the result dataclasses of this module and
-    :class:`~fegear.mechanics.hertz_closed_form.HertzPoint`; :func:`from_record` gives back an
-    equal object bit for bit.
-
-    Raises
-    ------
-    TypeError
-        Anything else (naming its type and ``key``).
-    """
-    return records.to_record(obj, arrays, key, _RECORD_CLASSES)
-
-
-def from_record(doc: object, arrays: Mapping[str, np.ndarray]) -> object:
-    """The object of :func:`to_record` (``arrays``: its arrays, e.g. an ``np.load`` of them)."""
-    return records.from_record(doc, arrays, _RECORD_CLASSES)
