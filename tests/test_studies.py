@@ -63,6 +63,18 @@ def test_a_study_reads_the_meshes_and_operators_of_the_nominal_run(seed_case, wh
     assert use.built.get("cycle") == 1 and "cycle" not in use.hits, (what, use)
 
 
+def test_a_process_builds_each_member_model_once(seed_case):
+    """A process running a study (a sweep worker, a script over installation errors) keeps the
+    member models of its last run (``fegear.ltca.analysis._MODELS``): the next run of the same
+    members is given the very same objects, its cache record counting them as the hits reading
+    them again would be (the parametrized test above asserts those counts)."""
+    a = fegear.run(seed_case.with_errors(dgamma_deg=0.01), workers=1).run
+    b = fegear.run(seed_case.with_errors(dgamma_deg=-0.01), workers=1).run
+    assert b.cycle.models.pinion is a.cycle.models.pinion
+    assert b.cycle.models.gear is a.cycle.models.gear
+    assert "mesh" not in b.cache.built and b.cache.hits["mesh"] == 2, b.cache
+
+
 def _cycle_numbers(result):
     """Every number of the loaded cycle that the solve produces, flattened: TEs, the lag, the
     cell forces and gaps of every position."""

@@ -17,6 +17,7 @@ import numpy as np
 
 from fegear.errors import InputError
 from fegear.forked import apart, process_count
+from fegear.linalg.schur import resolve_backend
 from fegear.ltca.fidelity import Fidelity, fidelity_of
 from fegear.ltca.model import (
     MemberModel,
@@ -29,6 +30,7 @@ from fegear.mesh.sector import FINE, mesh_sizes, sector_mesh
 from fegear.mesh.sector_geometry import sector_frame
 from fegear.options import ContactOptions
 from fegear.store.cache import count_lookups, recorded
+from fegear.store.memo import Memo
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 
@@ -38,6 +40,12 @@ log = logging.getLogger(__name__)
 
 # The cycle whose TCA gives the contact zone of the sector meshes (cycle_zone).
 _ZONE_POSITIONS = 25
+
+#: The member models last built in this process (one pair: two), given again to the next run
+#: of the same members while their cache entries are unchanged (:mod:`fegear.store.memo`):
+#: a sweep worker, a script over installation errors or a loop over fegear.run builds each
+#: model once.
+_MODELS: Memo[MemberModel] = Memo("member model", 2)
 
 
 @dataclass(frozen=True)
@@ -230,10 +238,21 @@ def build_models(
             teeth=loaded,
         )
 
+    # what a member's model is made from (its mesh and operator entries' keys hold the same)
+    made_of = [
+        {"member": repr(m), "side": sides[i], "n_teeth": n, "level": options.level,
+         "E": options.E_MPa, "nu": options.nu, "backend": resolve_backend(options.backend),
+         "layer_mm": layer, "teeth": loaded}
+        for i, m in enumerate((pinion, gear))
+    ]  # fmt: skip
+    kept = [_MODELS.holds(p) for p in made_of]
     # the gear's sector meshed in a second process while this one meshes the pinion's and
     # builds its operator; one process: one after the other (the same meshes and operators)
-    meshes = _sector_meshes_apart((pinion, gear), sides, n, options.level, options.workers)
-    models = [model(i, get()) for i, get in enumerate(meshes)]
+    workers = options.workers if not kept[1] else 1  # a kept gear model needs no mesh
+    meshes = (
+        [] if all(kept) else _sector_meshes_apart((pinion, gear), sides, n, options.level, workers)
+    )
+    models = [_MODELS.get(made_of[i], lambda i=i: model(i, meshes[i]()))[0] for i in range(2)]
     cell = options.cell_mm if options.cell_mm is not None else h
     return MemberModels(
         models[0],

@@ -501,6 +501,43 @@ def count_lookups(lookups: Lookups) -> None:
         rec.pinned.update(lookups.used)
 
 
+def entries_stamp(used: frozenset[tuple[str, str]]) -> tuple:
+    """The identity of the files of the cache entries ``used`` (``(kind, key)``, as
+    :attr:`Lookups.used`): the cache root, and for each file of each entry its name, inode and
+    size, and for a data file its modification time too (a record's is its last use). Equal
+    stamps: the entries are the very files they were (not deleted, rebuilt, truncated or
+    rewritten since)."""
+    root = cache_root()
+    stamp = []
+    for kind, key in sorted(used):
+        files = []
+        for p in sorted((root / kind).glob(f"{key}.*")):
+            try:
+                st = p.stat()
+            except OSError:
+                continue
+            record = p.name == f"{key}{RECORD_SUFFIX}"
+            files.append((p.name, st.st_ino, st.st_size, None if record else st.st_mtime_ns))
+        stamp.append((kind, key, tuple(files)))
+    return (str(root), tuple(stamp))
+
+
+def reuse_entries(lookups: Lookups, stamp: tuple) -> bool:
+    """Count a value made from cache entries and kept in the process as read from them again:
+    when the entries are still the files they were (:func:`entries_stamp` equal to ``stamp``),
+    each is marked used (its last use, and kept by the size cap while the work runs) and the
+    lookups that made the value (``lookups``: hits and builds) count as hits of their kinds;
+    True. False when anything changed (the value must be made again from the cache)."""
+    if entries_stamp(lookups.used) != stamp:
+        return False
+    for kind, key in lookups.used:
+        _used(cache_dir(kind), key)
+    for kind, n in (Counter(lookups.hits) + Counter(lookups.built)).items():
+        for _ in range(n):
+            _count(kind, True)
+    return True
+
+
 def _count(kind: str, hit: bool) -> None:
     for rec in _RECORDERS:
         (rec.hits if hit else rec.built)[kind] += 1
