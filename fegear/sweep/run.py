@@ -473,8 +473,9 @@ def run_item(
     cache_root
         Mesh/operator cache folder (``$FEGEAR_CACHE``) to use in this worker.
     position_workers
-        Processes for the item's mesh positions (:mod:`fegear.ltca.cycle`): the cores left to
-        each item by the sweep's own workers (1 on a Dask cluster; None: ``$FEGEAR_WORKERS``
+        Processes for the item's mesh positions (:mod:`fegear.ltca.cycle`) and, with two or
+        more, its pictures drawn beside its VTK files: the cores left to each item by the
+        sweep's own workers (1 on a Dask cluster; None: ``$FEGEAR_WORKERS``
         or one per core).
     """
     out = Path(out)
@@ -488,7 +489,8 @@ def run_item(
     try:
         tmp.mkdir(parents=True)
         run = run_gear_case(item.case, workers=position_workers, fields=False)
-        write_gear_outputs(tmp, run)  # the fields beside the pictures
+        # the fields and VTK files here while the pictures are drawn in a forked process
+        write_gear_outputs(tmp, run, workers=position_workers)
         seconds = time.perf_counter() - t0
         write_json(
             tmp / MARKER,
