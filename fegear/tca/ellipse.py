@@ -141,16 +141,21 @@ class ContactCurvature:
         return not self.A > LINE_CONTACT_RATIO * max(self.B, 1e-300) or not self.B > 0
 
 
-def _flank_tangents(fm, uv: Array, M: Array) -> Array:
-    """``(3, 2)``: ``∂X/∂u``, ``∂X/∂v`` of flank ``fm`` at flank coordinates ``uv`` (fixed frame,
-    ``M`` the member's placement), central differences inside the working flank."""
+def _tangent_points(fm, uv: Array) -> tuple[Array, Array, tuple[float, float]]:
+    """``(U, V, h)``: the four flank coordinates ``(u ± h_u, v)``, ``(u, v ± h_v)`` of the
+    central differences of :func:`_flank_tangents` at ``uv``, kept inside the working flank."""
     bd = fm.bounds
     h = (_TANGENT_STEP * (bd.u_tip - bd.u_fillet), _TANGENT_STEP * (bd.v_end - bd.v_start))
     u = float(np.clip(uv[0], bd.u_fillet + h[0], bd.u_tip - h[0]))
     v = float(np.clip(uv[1], bd.v_start + h[1], bd.v_end - h[1]))
-    U = np.array([u + h[0], u - h[0], u, u])
-    V = np.array([v, v, v + h[1], v - h[1]])
-    p = fm.evaluate(*fm.native(U, V))[0]
+    return np.array([u + h[0], u - h[0], u, u]), np.array([v, v, v + h[1], v - h[1]]), h
+
+
+def _flank_tangents(fm, ab: tuple[Array, Array], h: tuple[float, float], M: Array) -> Array:
+    """``(3, 2)``: ``∂X/∂u``, ``∂X/∂v`` of flank ``fm`` by central differences over the
+    native coordinates ``ab`` of :func:`_tangent_points` (steps ``h``), in the fixed frame
+    (``M`` the member's placement)."""
+    p = fm.evaluate(*ab)[0]
     t = np.stack([(p[0] - p[1]) / (2 * h[0]), (p[2] - p[3]) / (2 * h[1])], -1)  # (3, 2)
     return apply_vectors(M, t.T).T
 
@@ -181,7 +186,11 @@ def contact_curvature(
     K = []
     out = {}
     for name, fm, uv, M in (("pinion", fm1, uv1, M1), ("gear", fm2, uv2, M2)):
-        pa, pb = fm.native(uv[0], uv[1])
+        # the contact point and the tangents' four points in one native solve (an envelope
+        # solve of the face gear costs about the same for one point as for five)
+        U, V, ht = _tangent_points(fm, np.asarray(uv, dtype=float))
+        A, B = fm.native(np.concatenate([[uv[0]], U]), np.concatenate([[uv[1]], V]))
+        pa, pb = A[0], B[0]
         nrm = fm.evaluate(pa, pb)[1]
         h = (50 * fm.step[0], 50 * fm.step[1])
         lo, hi = fm.native_box()
@@ -194,7 +203,7 @@ def contact_curvature(
         K.append(k[0] * np.outer(d[0], d[0]) + k[1] * np.outer(d[1], d[1]))
         out[f"{name}_k"] = np.asarray(k, dtype=float)
         out[f"{name}_dirs"] = np.asarray(d, dtype=float)
-        out[f"{name}_tangents"] = _flank_tangents(fm, np.asarray(uv, dtype=float), M)
+        out[f"{name}_tangents"] = _flank_tangents(fm, (A[1:], B[1:]), ht, M)
     n1 = np.asarray(n1, dtype=float)
     e1 = np.cross(n1, [0.0, 0.0, 1.0]) if abs(n1[2]) < 0.9 else np.cross(n1, [1.0, 0.0, 0.0])
     e1 /= np.linalg.norm(e1)
