@@ -6,6 +6,7 @@ them. The modules of the result model, the pipeline, the writers and the API sta
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -29,12 +30,19 @@ def _node(module: str) -> str | None:
     return parts[1] if len(parts) > 1 else None
 
 
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The parsed source of one file, parsed once per session: every test reads the same
+    sources, and parsing the whole package took ~1 s per test (no test changes a tree)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
 def _imports(path: Path) -> list[tuple[str, int]]:
     """``[(imported fegear module, line)]`` of one source file, relative imports resolved."""
     module = _module_name(path)
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     out = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(_tree(path)):
         if isinstance(node, ast.Import):
             out += [(a.name, node.lineno) for a in node.names if a.name.startswith("fegear")]
         elif isinstance(node, ast.ImportFrom):
@@ -50,8 +58,10 @@ def _imports(path: Path) -> list[tuple[str, int]]:
     return out
 
 
+@functools.cache
 def _graph() -> dict[str, dict[str, list[str]]]:
-    """``{node: {imported node: ["module:line", ...]}}`` over every source file."""
+    """``{node: {imported node: ["module:line", ...]}}`` over every source file (built once per
+    session, read by several tests: none changes it)."""
     graph: dict[str, dict[str, list[str]]] = {}
     for path in sorted(PACKAGE.rglob("*.py")):
         src = _node(_module_name(path))
@@ -112,7 +122,7 @@ def _runtime_imports(path: Path) -> list[tuple[str, int]]:
     the module ``package.name`` where ``name`` is one."""
     module = _module_name(path)
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     typing_only = {
         id(n)
         for node in ast.walk(tree)
@@ -137,10 +147,11 @@ def _runtime_imports(path: Path) -> list[tuple[str, int]]:
     return out
 
 
+@functools.cache
 def _module_graph() -> dict[str, dict[str, list[str]]]:
     """``{module: {imported module: ["path:line", ...]}}`` over every source file (an import of
     a name resolves to the deepest module that holds it: ``fegear.ltca.grid.pair_cells`` →
-    ``fegear.ltca.grid``)."""
+    ``fegear.ltca.grid``; built once per session, read by several tests: none changes it)."""
     modules = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
     graph: dict[str, dict[str, list[str]]] = {}
     for src, path in modules.items():
@@ -169,7 +180,7 @@ def _local_imports(path: Path) -> list[ast.ImportFrom | ast.Import]:
                     out.append(child)
             visit(child, in_function or isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef))
 
-    visit(ast.parse(path.read_text(encoding="utf-8")), False)
+    visit(_tree(path), False)
     return out
 
 
