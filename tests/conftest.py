@@ -51,9 +51,16 @@ def fegear_cache() -> Path:
 
 @pytest.fixture(scope="session")
 def spiral_bevel_pair():
-    """The default spiral bevel pair, ``SpiralBevelPair.design()``, synthesized once for the
-    session (10-25 s: the third-order roll is tuned on the unloaded TE) and shared by the test
-    modules that use it as it is (a frozen dataclass; its members' caches only memoize)."""
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
+    """The reference spiral bevel pair, shared by the test modules that use it as it is (a
+    frozen dataclass; its members' caches only memoize): the pair of
+    ``cases/spiral_bevel_nominal.toml`` as ``build_pair`` makes it, the blank data of
+    ``SpiralBevelPair.design()`` but the module as the case file writes it (4.941634 mm for
+    25.4/5.14, 5e-8 relative). The synthesis (10-25 s: the third-order roll is tuned on the
+    unloaded TE) is made once per process and shared with every spiral bevel case run in it
+    (the artefact cache and ``build_pair``'s memo), not made a second time for the exact
+    module."""
+    from fegear.case_files import load_case
+    from fegear.pipeline.pair import build_pair
 
-    return SpiralBevelPair.design()
+    case = load_case(Path(__file__).resolve().parents[1] / "cases" / "spiral_bevel_nominal.toml")
+    return build_pair(case).spiral_bevel

@@ -236,7 +236,7 @@ def test_override_single_setting(pair):
     new = dataclasses.replace(
         s, pinion_drive=dataclasses.replace(s.pinion_drive, modified_roll=0.0)
     )
-    p2 = SpiralBevelPair.design(settings=new)
+    p2 = SpiralBevelPair.design(pair.blank, pair.targets, settings=new)  # only the roll differs
     assert p2.pinion.drive.modified_roll == 0.0
     a, _ = p2.pinion.point_normal("drive", 0.5, 85.0)
     b, _ = pair.pinion.point_normal("drive", 0.5, 85.0)
