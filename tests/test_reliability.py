@@ -4,6 +4,11 @@
 Written on the FZG spur pair (``cases/fzg_spur.toml``), the spiral bevel and synthetic inputs;
 the face gear only where the row is about it, asserting behaviour (exit code, field named), not
 its numbers (its flanks are being extended to the real fillet limit).
+
+At the end, the spiral bevel's loaded analysis at fixed positions (issue 6; it was
+``tests/test_ltca_bevel.py``): in this module it reads the sector meshes and operators the
+spiral bevel row's run built in this process (~25 s cold) instead of building them again in
+another.
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ import pytest
 from cli_checks import assert_refused
 
 from fegear.cli import main
+from fegear.geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
+from fegear.ltca import LTCAOptions, build_models, run_ltca
 
 REPO = Path(__file__).resolve().parents[1]
 FZG = REPO / "cases" / "fzg_spur.toml"
@@ -503,3 +510,47 @@ def test_workers_one_and_two_give_the_same_numbers_at_hybrid(tmp_path, fzg_shipp
     a, b = numbers(docs[0]), numbers(docs[1])
     assert a.shape == b.shape
     np.testing.assert_allclose(a, b, rtol=1e-9, atol=0.0)
+
+
+# --------------------------------------------------------------------------------------------
+# The spiral bevel's loaded analysis at fixed positions (issue 6; FE sectors at level 0)
+# --------------------------------------------------------------------------------------------
+#
+# The 12/36 pair at a fixed mesh position: the number of tooth pairs in contact is found by the
+# solver; raising the torque closes the separations of the neighbouring pairs one after the
+# other (1 → 2 → 3). The sectors and their flank operators are those of the nominal case's
+# contact zone: after the p_max row above, read from the cache.
+
+BEVEL_OPTIONS = LTCAOptions(n_positions=9, level=0)
+
+
+@pytest.fixture(scope="module")
+def bevel(spiral_bevel_pair):
+    pair = spiral_bevel_pair  # the session's (tests/conftest.py): the nominal case's pair
+    asm = spiral_bevel_assembly(pair, "drive", InstallationErrors())
+    return pair, asm, build_models(pair.pinion, pair.gear, asm, BEVEL_OPTIONS)
+
+
+def test_bevel_pairs_in_contact_go_from_one_to_three_with_torque(bevel):
+    pair, asm, models = bevel
+    phi = np.array([-math.pi / 12 + 2 * math.pi / 12 * 5 / 9])  # 1.67 deg: mid single contact
+    counts, balance = [], []
+    for torque in (1e4, 1e5, 4e5, 1e6):  # N·mm on the gear (10 ... 1000 N·m)
+        c = run_ltca(pair.pinion, pair.gear, asm, torque, BEVEL_OPTIONS, phi1=phi,
+                     models=models)  # fmt: skip
+        counts.append(int(c.n_in_contact[0]))
+        balance.append(c.positions[0].solution.equilibrium_residual)
+    # measured 1, 1, 3, 3: the count is the active set's, never an input
+    assert counts[0] == 1 and counts[-1] == 3, counts
+    assert counts == sorted(counts), counts
+    assert max(balance) < 1e-9  # torque balance enforced by the solver
+
+
+def test_bevel_loaded_te_keeps_the_designed_parabola_at_light_load(bevel):
+    pair, asm, models = bevel
+    c = run_ltca(pair.pinion, pair.gear, asm, 1e4, BEVEL_OPTIONS, models=models)
+    # unloaded: the predesigned parabola of ~8 arcsec (TCA tests); loaded at 10 N·m: a small lag
+    # on top, so the curve keeps its parabolic peak-to-peak within a few arcsec
+    assert 8.0 * 0.9 < c.te_pp_unloaded_arcsec < 8.0 * 1.1
+    assert np.all(c.te_loaded_arcsec <= c.te_unloaded_arcsec + 1e-9)  # the load only lags
+    assert abs(c.te_pp_loaded_arcsec - c.te_pp_unloaded_arcsec) < 4.0
