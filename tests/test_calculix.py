@@ -1,7 +1,9 @@
 """The CalculiX cross-check (docs/calculix.md): decks fegear exports, run by ``ccx``, read back.
 
 The deck tests run everywhere; the tests that run ``ccx`` are skipped when it is not installed
-(Debian/Ubuntu: ``apt-get install calculix-ccx``; or ``$FEGEAR_CCX``).
+(Debian/Ubuntu: ``apt-get install calculix-ccx``; or ``$FEGEAR_CCX``). The spiral bevel's deck is
+checked in ``tests/test_reliability.py``, beside the nominal case's run whose contact zone it
+reads.
 """
 
 from __future__ import annotations
@@ -119,52 +121,6 @@ def test_hertz_export_defaults_to_level_1(tmp_path):
     assert rec["element_mm"] == pytest.approx(ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[1])
     with pytest.raises(InputError, match="level"):
         export_ccx(case, tmp_path, level=len(CELLS_ACROSS_MINOR))
-
-
-def test_spiral_bevel_deck_is_valid_with_a_pair_per_closing_tooth_pair():
-    """The spiral bevel at position 6 with 1 mm contact elements (the cross-check's coarsest):
-    positive C3D10 volumes, mid-edge nodes at their edges' midpoints but for the flank
-    nodes moved onto the flank, and one contact pair per tooth pair that can touch: every pair
-    whose sampled separation at the position is within the deck's reach, none that is not a
-    valid pair there, and the other valid pairs recorded as left out."""
-    from fegear.export import position_angle
-    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck
-    from fegear.ltca import LTCAOptions
-    from fegear.ltca.cycle import cycle_tca
-    from fegear.pipeline.pair import build_pair
-
-    case = load_case(CASES / "spiral_bevel_nominal.toml")
-    phi1 = position_angle(case, 6)
-    deck = gear_deck(case, phi1, 1.0)
-    xyz, el = _deck_elements(deck.text)
-    assert el.shape[1] == 10
-    assert np.all(_volumes(xyz, el) > 0.0)
-    dev, _ = _mid_edge_offsets(xyz, el)
-    rec = deck.record
-    # a mid-edge node moves only onto the flank, by at most the largest move the record states
-    assert np.max(dev) <= max(rec["projected_mm"].values()) + 1e-9
-    # the pairs the TCA closes within the reach at this position (the deck's own TCA inputs)
-    pair = build_pair(case)
-    opt = LTCAOptions(n_positions=case.n_positions, level=case.level, n_teeth=case.n_teeth,
-                      E_MPa=case.E_MPa, nu=case.nu, fidelity="fe")  # fmt: skip
-    _, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt, np.array([phi1]))
-    sep = {(g.k, g.j): float(np.min(g.separation[g.valid], initial=np.inf))
-           for g in positions[0].grids}  # fmt: skip
-    in_deck = {(p["k"], p["j"]) for p in rec["pairs"]}
-    sampled = {kj for kj, s in sep.items() if s <= DEFAULT_REACH_MM}
-    # the deck also takes a pair whose exact closest point (between the samples) is within the
-    # reach: its sampled separation exceeds the reach by less than the sampling's sag
-    assert sampled <= in_deck and all(sep[kj] <= 2 * DEFAULT_REACH_MM for kj in in_deck)
-    assert len(in_deck) >= 1
-    assert deck.text.count("*CONTACT PAIR") == 1  # one card, one line per pair
-    for p in rec["pairs"]:
-        assert f"\n{p['slave']}, {p['master']}\n" in deck.text
-    left = {(q["k"], q["j"]) for q in rec["left_out"]}
-    assert not (left & in_deck)
-    assert sorted(in_deck | left) == sorted(
-        (int(k), int(j)) for (k, j), ok in zip(positions[0].pairs, positions[0].pair_valid,
-                                               strict=True) if ok
-    )  # fmt: skip
 
 
 def test_dat_reader_reads_the_last_contact_statistics(tmp_path):

@@ -6,8 +6,9 @@ the face gear only where the row is about it, asserting behaviour (exit code, fi
 its numbers (its flanks are being extended to the real fillet limit).
 
 At the end, the spiral bevel's loaded analysis at fixed positions (issue 6; it was
-``tests/test_ltca_bevel.py``): in this module it reads the sector meshes and operators the
-spiral bevel row's run built in this process (~25 s cold) instead of building them again in
+``tests/test_ltca_bevel.py``) and its CalculiX deck (it was in ``tests/test_calculix.py``): in
+this module they read the sector meshes and operators, and the contact zone, that the spiral
+bevel row's run built in this process (~25 s and ~15 s cold) instead of building them again in
 another.
 """
 
@@ -554,3 +555,58 @@ def test_bevel_loaded_te_keeps_the_designed_parabola_at_light_load(bevel):
     assert 8.0 * 0.9 < c.te_pp_unloaded_arcsec < 8.0 * 1.1
     assert np.all(c.te_loaded_arcsec <= c.te_unloaded_arcsec + 1e-9)  # the load only lags
     assert abs(c.te_pp_loaded_arcsec - c.te_pp_unloaded_arcsec) < 4.0
+
+
+# --------------------------------------------------------------------------------------------
+# The spiral bevel's CalculiX deck (docs/calculix.md): the nominal case's contact zone (its TCA)
+# is the one the p_max row above computed
+# --------------------------------------------------------------------------------------------
+
+
+def test_spiral_bevel_deck_is_valid_with_a_pair_per_closing_tooth_pair():
+    """The spiral bevel at position 6 with 1 mm contact elements (the cross-check's coarsest):
+    positive C3D10 volumes, mid-edge nodes at their edges' midpoints but for the flank
+    nodes moved onto the flank, and one contact pair per tooth pair that can touch: every pair
+    whose sampled separation at the position is within the deck's reach, none that is not a
+    valid pair there, and the other valid pairs recorded as left out."""
+    from test_calculix import _deck_elements, _mid_edge_offsets, _volumes
+
+    from fegear.case_files import load_case
+    from fegear.export import position_angle
+    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck
+    from fegear.ltca import LTCAOptions
+    from fegear.ltca.cycle import cycle_tca
+    from fegear.pipeline.pair import build_pair
+
+    case = load_case(BEVEL)
+    phi1 = position_angle(case, 6)
+    deck = gear_deck(case, phi1, 1.0)
+    xyz, el = _deck_elements(deck.text)
+    assert el.shape[1] == 10
+    assert np.all(_volumes(xyz, el) > 0.0)
+    dev, _ = _mid_edge_offsets(xyz, el)
+    rec = deck.record
+    # a mid-edge node moves only onto the flank, by at most the largest move the record states
+    assert np.max(dev) <= max(rec["projected_mm"].values()) + 1e-9
+    # the pairs the TCA closes within the reach at this position (the deck's own TCA inputs)
+    pair = build_pair(case)
+    opt = LTCAOptions(n_positions=case.n_positions, level=case.level, n_teeth=case.n_teeth,
+                      E_MPa=case.E_MPa, nu=case.nu, fidelity="fe")  # fmt: skip
+    _, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt, np.array([phi1]))
+    sep = {(g.k, g.j): float(np.min(g.separation[g.valid], initial=np.inf))
+           for g in positions[0].grids}  # fmt: skip
+    in_deck = {(p["k"], p["j"]) for p in rec["pairs"]}
+    sampled = {kj for kj, s in sep.items() if s <= DEFAULT_REACH_MM}
+    # the deck also takes a pair whose exact closest point (between the samples) is within the
+    # reach: its sampled separation exceeds the reach by less than the sampling's sag
+    assert sampled <= in_deck and all(sep[kj] <= 2 * DEFAULT_REACH_MM for kj in in_deck)
+    assert len(in_deck) >= 1
+    assert deck.text.count("*CONTACT PAIR") == 1  # one card, one line per pair
+    for p in rec["pairs"]:
+        assert f"\n{p['slave']}, {p['master']}\n" in deck.text
+    left = {(q["k"], q["j"]) for q in rec["left_out"]}
+    assert not (left & in_deck)
+    assert sorted(in_deck | left) == sorted(
+        (int(k), int(j)) for (k, j), ok in zip(positions[0].pairs, positions[0].pair_valid,
+                                               strict=True) if ok
+    )  # fmt: skip
