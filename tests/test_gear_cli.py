@@ -5,8 +5,9 @@ docs/testing.md).
   line on stderr naming the problem and exit code 2, before any work.
 - End to end on the FZG spur pair at level 0 (default suite): summary keys, the ``.pvd`` read
   back with pyvista (time steps, pressure field, total cell force equal to the solver's).
-- Smoke runs: the spiral bevel cases (unloaded TCA; loaded at hybrid: ``slow``) and the
-  face-gear cases and the no-argument main job (``slow``: ~1 min cold each).
+- Smoke runs: the spiral bevel cases (unloaded TCA of ΔE by default, of the others ``slow``;
+  loaded at hybrid: ``slow``) and the face-gear cases and the no-argument main job (``slow``:
+  ~1 min cold each).
 """
 
 from __future__ import annotations
