@@ -316,6 +316,170 @@ def test_compare_runs_table_and_pictures(fzg, tmp_path):
         assert f({"a": result}, tmp_path / f"{f.__name__}.png").read_bytes()[:4] == b"\x89PNG"
 
 
+# --------------------------------------------------------------------------------------------
+# End to end through `fegear run`: the FZG spur pair as shipped (hybrid level 0), 5 positions
+# (was in tests/test_gear_cli.py; here the run reads what the API's run above built)
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def fzg_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fzg")
+    case = tmp_path_factory.mktemp("case") / "fzg.toml"
+    text = FZG.read_text(encoding="utf-8")
+    assert "n_positions = 9" in text
+    case.write_text(text.replace("n_positions = 9", f"n_positions = {N_FZG}"), "utf-8")
+    # --recompute: solved here although the API's run above is in the cache (read from the
+    # cache, a run has no models timing, asserted below); its sectors, operators and checks
+    # are read
+    code = main(["run", str(case), "--level", "0", "--out", str(out), "-q", "--recompute"])
+    return code, out
+
+
+def _get(doc, dotted: str):
+    for k in dotted.split("."):
+        if k.isdigit():
+            doc = doc[int(k)]
+        else:
+            assert k in doc, f"summary.json has no {dotted!r}"
+            doc = doc[k]
+    return doc
+
+
+def test_fzg_run_writes_the_summary_keys(fzg_run):
+    code, out = fzg_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["kind"] == "spur" and doc["fidelity"] == "hybrid" and doc["level"] == 0
+    for key in ("te_pp_unloaded_arcsec", "te_pp_loaded_arcsec", "contact_ratio_loaded",
+                "p_max_MPa"):  # fmt: skip
+        v = _get(doc, f"cycle.{key}")
+        assert isinstance(v, float) and math.isfinite(v), key
+    assert len(doc["positions"]) == N_FZG
+    # conjugate involute pair: no unloaded TE (invariant, to the TCA's round-off)
+    assert _get(doc, "cycle.te_pp_unloaded_arcsec") < 1e-6
+    # loaded: a lag (negative TE) at every position; one or two pairs (contact ratio 1.46)
+    assert 1.0 <= _get(doc, "cycle.contact_ratio_loaded") <= 2.0
+    for i, pos in enumerate(doc["positions"]):
+        assert _get(pos, "te_loaded_arcsec") < 0
+        assert -12.0 <= _get(pos, "pinion_angle_deg") < 12.0  # one cycle, 360/16 = 22.5 deg
+        shares = [_get(q, "load_share") for q in pos["pairs"]]
+        # torque balance is enforced by the solver: round-off
+        assert abs(sum(shares) - 1.0) < 1e-9, (i, shares)
+        assert pos["solver"]["equilibrium_residual"] < 1e-9
+        for q in pos["pairs"]:
+            assert isinstance(q["edge_contact"], bool)
+            assert q["p_max_MPa"] >= 0
+            if q["in_contact"]:
+                cp = np.array(q["contact_point_mm"])
+                # fixed frame: pinion axis +z at the origin; the contact lies between the base
+                # circle (r_b1 = 33.8 mm) and the tip circle (~41.6 mm) of the pinion
+                r = math.hypot(cp[0], cp[1])
+                assert 33.0 < r < 42.0 and abs(cp[2]) <= 7.0 + 1e-9, cp
+            else:
+                assert q["contact_point_mm"] is None
+    assert doc["versions"]["fegear"] and doc["timings_s"]["models"] > 0
+    assert doc["units"]["pressure"] == "MPa"
+    # what the sectors modelled: every pair in contact at some position has a fine zone, and
+    # 5 teeth hold the pairs -1, 0, +1 of a contact ratio of 1.46 with a neighbour each side
+    zone = _get(doc, "cycle.contact_zone")
+    modelled = {tuple(p) for p in zone["pairs"]}
+    touching = {(q["pinion_tooth"], q["gear_tooth"]) for p in doc["positions"] for q in p["pairs"]}
+    assert touching <= modelled and zone["sector_teeth"] == 5 and zone["gap_mm"] > 0
+    # the headline p_max is the largest pressure away from the edges over the usable positions,
+    # the edge value beside it (issue 21)
+    usable = [p for p in doc["positions"] if p["status"] == "ok"]
+    assert _get(doc, "cycle.te_pp_loaded_positions_used") == len(usable) == N_FZG
+    assert _get(doc, "cycle.p_max_MPa") == max(
+        q["p_interior_MPa"] for p in usable for q in p["pairs"] if q["p_interior_MPa"] is not None
+    )
+    edge = [q["p_edge_MPa"] for p in usable for q in p["pairs"] if q["p_edge_MPa"] is not None]
+    assert _get(doc, "cycle.p_max_edge_MPa") == (max(edge) if edge else None)
+
+
+def test_fzg_pvd_reads_back_with_pyvista(fzg_run):
+    import pyvista as pv
+
+    code, out = fzg_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    reader = pv.get_reader(str(out / "cycle.pvd"))
+    assert reader.number_time_points == N_FZG
+    angles = [p["pinion_angle_deg"] for p in doc["positions"]]
+    np.testing.assert_allclose(reader.time_values, angles, rtol=0, atol=1e-9)
+    for i, t in enumerate(reader.time_values):
+        reader.set_active_time_value(t)
+        blocks = reader.read()
+        assert blocks.n_blocks == 5  # pinion, gear, contact cells, pinion and gear flank views
+        pinion, gear, cells = blocks[0], blocks[1], blocks[2]
+        for b in (pinion, gear, cells, blocks[3], blocks[4]):
+            # the time of the series is the pinion angle in degrees, in every file's field data
+            assert b.field_data["pinion_angle_deg"][0] == pytest.approx(t, abs=1e-9)
+        for flank in (blocks[3], blocks[4]):
+            assert flank.field_data["time_unit"][0] == "pinion angle phi1 (deg)"
+            loaded = flank.cell_data["outline"] == 0
+            # the flank views hold the solver's loaded cells: their forces add up to the
+            # position's force, their largest pressure is the position's (float64: round-off)
+            total_i = doc["positions"][i]["total_force_N"]
+            assert flank.cell_data["force_N"][loaded].sum() == pytest.approx(total_i, rel=1e-9)
+            assert flank.cell_data["pressure_MPa"].max() == pytest.approx(
+                doc["positions"][i]["p_max_MPa"], rel=1e-12
+            )
+        for member in (pinion, gear):
+            assert {"pressure_MPa", "displacement_mm", "in_contact"} <= set(member.point_data)
+            u = member.point_data["displacement_mm"]
+            assert u.shape == (member.n_points, 3) and np.all(np.isfinite(u))
+            assert member.point_data["pressure_MPa"].max() > 0  # the loaded flank shows
+        force = cells.cell_data["force_N"]
+        pressure = cells.cell_data["pressure_MPa"]
+        area = cells.cell_data["area_mm2"]
+        total = doc["positions"][i]["total_force_N"]
+        pairs = sum(q["force_N"] for q in doc["positions"][i]["pairs"])
+        # the cell field is the solver output written in float64: equal to round-off
+        assert abs(force.sum() - total) <= 1e-6 * total
+        assert abs((pressure * area).sum() - total) <= 1e-6 * total
+        assert abs(pairs - total) <= 1e-9 * total
+        assert pressure.max() == pytest.approx(doc["positions"][i]["p_max_MPa"], rel=1e-12)
+        # the flank-node pressures are cell pressures (no interpolation overshoot)
+        assert pinion.point_data["pressure_MPa"].max() <= pressure.max() * (1 + 1e-12)
+
+
+def test_fzg_members_are_placed_and_deformed_consistently(fzg_run):
+    """The loaded flank vertices of pinion and gear face each other (within an element of the
+    coarse mesh) and each member is pushed into its flank: the displacement at a loaded vertex
+    has a positive component against that member's outward flank direction."""
+    import meshio
+    from scipy.spatial import cKDTree
+
+    code, out = fzg_run
+    assert code == 0
+    for i in range(N_FZG):
+        pin = meshio.read(out / "vtk" / f"pinion_{i:03d}.vtu")
+        gear = meshio.read(out / "vtk" / f"gear_{i:03d}.vtu")
+        cells = meshio.read(out / "vtk" / f"contact_cells_{i:03d}.vtu")
+        centres = cells.points[cells.cells_dict["quad"]].mean(axis=1)
+        for m in (pin, gear):
+            loaded = m.points[m.point_data["pressure_MPa"] > 0]
+            # every loaded vertex sits over a contact cell: within a cell diagonal of one
+            # (cells ~2 mm at level 0)
+            assert cKDTree(centres).query(loaded)[0].max() < 4.0
+        # pinion: the pinion axis is +z at the origin; the gear centre is on +x
+        up = pin.point_data["displacement_mm"][pin.point_data["pressure_MPa"] > 0]
+        ug = gear.point_data["displacement_mm"][gear.point_data["pressure_MPa"] > 0]
+        # equal and opposite loads: the two members move apart along the line of action
+        assert np.dot(up.mean(axis=0), ug.mean(axis=0)) < 0
+
+
+def test_fzg_pngs_are_written(fzg_run):
+    code, out = fzg_run
+    assert code == 0
+    for name in ("te", "load_share", "p_max", "bearing_pattern"):
+        png = out / f"{name}.png"
+        assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+    # no temporary file left behind (atomic writes); the folder's list of the run's files
+    assert [p.name for p in out.rglob(".*")] == [".fegear-outputs"]
+
+
 def test_hertz_scene_through_the_api(tmp_path):
     case = fegear.load_case(HERTZ)
     r = fegear.run(case, level=0)
