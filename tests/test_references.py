@@ -5,7 +5,9 @@ solver that makes each number (``summaries.TOLERANCES``: the TCA's Newton tolera
 angles, the location of a minimum it implies for its contact points, the bisections' resolution
 for the path, the conditioning of the contact problem for the loaded cycle), so the references
 hold on any x86-64 machine and BLAS/numpy kernel. The unloaded TCA of the three nominal cases
-runs by default; every case at the TCA and at its own fidelity (level 0) is ``slow``.
+runs by default, in ``tests/test_validation.py`` (beside the spiral bevel's validation row, whose
+run is the nominal spiral bevel's at the TCA: read back from the cache there, not made again in
+another process); every case at the TCA and at its own fidelity (level 0) is ``slow``, here.
 Regenerate them with ``python tests/reference/summaries.py`` after a change meant to move them.
 """
 
@@ -38,11 +40,6 @@ def _check(case: Path, fidelity: str) -> None:
     )
     diff = summaries.differences(new, ref)
     assert not diff, f"{len(diff)} values moved:\n" + "\n".join(diff[:20])
-
-
-@pytest.mark.parametrize("name", NOMINAL)
-def test_the_nominal_cases_give_the_reference_tca(name):
-    _check(summaries.CASES / f"{name}.toml", "tca")
 
 
 @pytest.mark.slow

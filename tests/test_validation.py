@@ -16,6 +16,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 import pytest
+from test_references import NOMINAL, _check, summaries
 
 from fegear.validation import Row, Value, as_row
 from fegear.validation import rows as V
@@ -215,3 +216,16 @@ def test_the_page_has_every_row_and_its_command():
     for what in ("Hertz scene", "line Hertz", "ISO 6336-1", "ISO 6336-3", "parabolic TE",
                  "grows with the load"):  # fmt: skip
         assert what in text, what
+
+
+# --------------------------------------------------------------------------------------------
+# The nominal cases give their stored reference summaries (tests/reference/)
+# --------------------------------------------------------------------------------------------
+# From tests/test_references.py (whose slow tests check every case): here the nominal spiral
+# bevel's run at the TCA is the one of test_spiral_bevel_unloaded_te_is_the_design_parabola
+# above, read back from the cache.
+
+
+@pytest.mark.parametrize("name", NOMINAL)
+def test_the_nominal_cases_give_the_reference_tca(name):
+    _check(summaries.CASES / f"{name}.toml", "tca")
