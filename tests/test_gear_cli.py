@@ -242,7 +242,7 @@ BEVEL_CASES = sorted((REPO / "cases").glob("spiral_bevel_*.toml"))
 
 # dE by default; dG and dP (the same machinery, one more unloaded cycle each) slow. The nominal
 # case slow too: its unloaded TCA (13 positions, every number of its summary) is
-# tests/test_references.py::test_the_nominal_cases_give_the_reference_tca[spiral_bevel_nominal];
+# tests/test_validation.py::test_the_nominal_cases_give_the_reference_tca[spiral_bevel_nominal];
 # and dgamma: the TE of its installation (Δγ = +0.02°) is checked against the designed parabola
 # by tests/test_tca_spiral_bevel.py::test_errors_move_the_pattern_as_theory_says. The command
 # line and its pictures are those of dE here.
