@@ -124,3 +124,28 @@ def test_fields_of_a_cycle_read_back_are_those_of_its_models(seed_case):
     assert use.hits.get("compliance") == 8 and "compliance" not in use.built, use
     for a, b in zip(again.run.members, first.run.members, strict=True):
         np.testing.assert_array_equal(a.displacement, b.displacement)
+
+
+def test_the_same_run_again_copies_its_pictures(seed_case, tmp_path, monkeypatch):
+    """The pictures of a run are kept in the cache under its cycle and its summary
+    (:mod:`fegear.output.picture_cache`): the same run written again copies the bytes drawn the
+    first time and draws nothing; another title (the case's name) or a run solved again without
+    the cache (no cycle key) draws them."""
+    from fegear.output import gear_output
+
+    drawn = []
+    draw = gear_output.loaded_plots
+    monkeypatch.setattr(gear_output, "loaded_plots", lambda *a: drawn.append(1) or draw(*a))
+    case = seed_case.replace(torque2_Nm=1200.0)
+    fegear.run(case, workers=1).write(tmp_path / "first")
+    assert len(drawn) == 1
+    fegear.run(case, workers=1).write(tmp_path / "again")
+    assert len(drawn) == 1  # copied, not drawn
+    pngs = sorted(p.name for p in (tmp_path / "first").glob("*.png"))
+    assert pngs and pngs == sorted(p.name for p in (tmp_path / "again").glob("*.png"))
+    for name in pngs:
+        assert (tmp_path / "first" / name).read_bytes() == (tmp_path / "again" / name).read_bytes()
+    fegear.run(case.replace(name="renamed"), workers=1).write(tmp_path / "renamed")
+    assert len(drawn) == 2  # the titles quote the name: drawn
+    fegear.run(case, workers=1, reuse=False).write(tmp_path / "fresh")
+    assert len(drawn) == 3  # no cycle key: drawn, nothing kept

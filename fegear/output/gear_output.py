@@ -92,6 +92,7 @@ from fegear.output.flank_view import (
     pattern_centre,
 )
 from fegear.output.gear_plots import loaded_plots, tca_plots
+from fegear.output.picture_cache import keep_pictures, kept_pictures, picture_params
 from fegear.output.vtk import write_gear_vtk, write_pvd
 from fegear.pipeline.run import GearRun, with_fields
 from fegear.results.build import build_result
@@ -152,7 +153,9 @@ def write_gear_outputs(
     its result model (:func:`fegear.results.build_result`, with the views' pattern), built if
     not given. ``workers``: the processes the run may use (None: as the positions,
     ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
-    are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`).
+    are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`);
+    a run whose pictures are in the cache (the same run drawn before) has them copied
+    (:mod:`fegear.output.picture_cache`).
     A run whose displacement fields are pending (``run.fields_pending``) gets them here
     (:func:`fegear.pipeline.run.with_fields`) while the pictures are drawn (they show no
     field), and ``result`` is then built from the run with its fields.
@@ -165,13 +168,18 @@ def write_gear_outputs(
     result = result if result is not None and not pending else build_result(run, views.pattern)
     paths: list[Path] = []
     if run.cycle is not None:
-        fork = process_count(workers, 2) > 1
+        keep = picture_params(run, result)
+        kept = kept_pictures(out, keep)  # the same run drawn before: its pictures copied
+        fork = process_count(workers, 2) > 1 and kept is None
         plots = apart(lambda r=run, res=result: loaded_plots(out, r, res), fork)
         if pending:  # the fields while the pictures are drawn, then the model with them
             run = with_fields(run)
             result = build_result(run, views.pattern)
         paths += write_gear_vtk(out, run, views)
-        paths += plots()
+        if kept is None:
+            kept = plots()
+            keep_pictures(keep, kept)
+        paths += kept
         if is_cylindrical(run):
             paths.append(plot_line_load(out, run))
     else:

@@ -82,6 +82,7 @@ __all__ = [
     "Lookups",
     "recorded",
     "cached_record",
+    "find_record",
     "canonical",
     "check_cache_root",
     "RECORD_SUFFIX",
@@ -335,6 +336,9 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "bevel_pair": Producer(("fegear.geometry",), ("numpy", "scipy")),
         # the face gear's undercut/pointing limits and fillet-limit tables (fegear.pipeline.pair)
         "face_gear_limits": Producer(("fegear.geometry",), ("numpy", "scipy")),
+        # the PNG pictures of a loaded run (fegear.output.picture_cache), keyed on its cycle
+        # and its summary: a run read back from the cache copies them instead of drawing them
+        "pictures": Producer(("fegear.output", "fegear.results"), ("matplotlib", "numpy")),
     }
 )
 
@@ -721,6 +725,32 @@ def _gb(n: float) -> str:
     return f"{n / 1e9:.2f} GB"
 
 
+def find_record(
+    kind: str, params: Mapping[str, object], producer: Producer | None = None
+) -> tuple[Entry, dict] | None:
+    """``(entry, record)`` of ``params`` if the cache holds it complete and intact (a hit:
+    counted and marked used, as :func:`cached_record` does), else None (nothing counted).
+
+    For work that looks first and builds later, elsewhere (pictures drawn in a second process,
+    :mod:`fegear.output.picture_cache`): the entry is then written by :func:`cached_record`.
+
+    Raises
+    ------
+    ValueError
+        ``kind`` has no producer.
+    """
+    key = artefact_key(kind, params, producer)
+    folder = cache_dir(kind)
+    found = _read_record(folder, key)
+    if found is None:
+        return None
+    entry = Entry(folder, key, tuple(found[1]))
+    log.info("cache hit %s/%s", kind, entry.record_path.name)
+    _used(folder, key)
+    _count(kind, True)
+    return entry, found[0]
+
+
 def cached_record(
     kind: str,
     params: Mapping[str, object],
@@ -756,15 +786,11 @@ def cached_record(
         The entry (:meth:`Entry.path` of its data files), the record, and whether it came from
         the cache.
     """
-    key = artefact_key(kind, params, producer)  # a kind without a producer: refused first
-    folder = cache_dir(kind)
-    found = _read_record(folder, key)
+    found = find_record(kind, params, producer)  # a kind without a producer: refused first
     if found is not None:
-        entry = Entry(folder, key, tuple(found[1]))
-        log.info("cache hit %s/%s", kind, entry.record_path.name)
-        _used(folder, key)
-        _count(kind, True)
-        return entry, found[0], True
+        return found[0], found[1], True
+    key = artefact_key(kind, params, producer)
+    folder = cache_dir(kind)
     entry = Entry(folder, key)
     record = dict(build(entry))  # the data files, each written atomically
     paths = {f: entry.path(f) for f in entry.files}
