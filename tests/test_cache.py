@@ -320,3 +320,29 @@ def test_joined_cache_use_adds_the_counts_per_kind(tmp_path):
     assert j.root == tmp_path
     assert j.hits == {"mesh": 2, "tca": 3} and j.built == {"fields": 2, "layer": 3}
     assert not j.warm and fcache.CacheUse(tmp_path, {"tca": 1}, {}).joined(a).hits["tca"] == 2
+
+
+def test_find_record_looks_without_building(monkeypatch, tmp_path, caplog):
+    """``find_record`` is the hit half of ``cached_record``: None on a miss (nothing counted,
+    nothing written), the entry and its record once built; a damaged entry is deleted with a
+    warning and is a miss, as for ``cached_record``."""
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "c"))
+    made_by = fcache.Producer(("fegear.store",))
+    params = {"run": "r1"}
+    with fcache.record_cache_use() as used:
+        assert fcache.find_record("delta", params, made_by) is None
+    assert used().hits == {} and used().built == {}
+    assert fcache.cache_info().files == 0
+
+    def build(entry):
+        entry.write(".one.png", lambda p: p.write_bytes(b"png bytes"))
+        return {"names": ["one.png"]}
+
+    fcache.cached_record("delta", params, build, made_by)
+    with fcache.record_cache_use() as used:
+        entry, record = fcache.find_record("delta", params, made_by)
+    assert record == {"names": ["one.png"]} and used().hits == {"delta": 1}
+    assert entry.path(".one.png").read_bytes() == b"png bytes"
+    entry.path(".one.png").write_bytes(b"png bytez")  # same size, other bytes
+    assert fcache.find_record("delta", params, made_by) is None
+    assert "damaged" in caplog.text and not entry.record_path.exists()
