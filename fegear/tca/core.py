@@ -350,15 +350,21 @@ class TCA:
             a[m], b[m] = sa(t[m]), sb(t[m])
         return a, b
 
-    def _theta_edge(self, T: Array, e: Array, t: Array):
-        """Angular gap of gear edge points (edge ``e``, parameter ``t``; shape ``(C, m)``)."""
+    def _search_rz(self, T: Array) -> tuple[Array, Array]:
+        """``(ρ, z)``, each ``(C, g)``: the pinion search-grid points in the gear tooth frames
+        ``T (C, 4, 4)`` (the start points of :meth:`_theta_edge`; one per set of frames)."""
+        Pg = apply_points(T[:, None], self.sP[None])  # (C, g, 3)
+        return np.hypot(Pg[..., 0], Pg[..., 1]), Pg[..., 2]
+
+    def _theta_edge(self, T: Array, e: Array, t: Array, rz: tuple[Array, Array] | None = None):
+        """Angular gap of gear edge points (edge ``e``, parameter ``t``; shape ``(C, m)``);
+        ``rz``: :meth:`_search_rz` of ``T`` when the caller has it (the edge search evaluates
+        the same frames 20 times)."""
         a2, b2 = self._edge_native(e, t)
         R = self.fm2.evaluate(a2, b2)[0]
         rho, z = np.hypot(R[..., 0], R[..., 1]), R[..., 2]
-        Pg = apply_points(T[:, None], self.sP[None])  # (C, g, 3)
-        d = (np.hypot(Pg[..., 0], Pg[..., 1])[:, None, :] - rho[..., None]) ** 2 + (
-            Pg[..., 2][:, None, :] - z[..., None]
-        ) ** 2
+        rg, zg = self._search_rz(T) if rz is None else rz
+        d = (rg[:, None, :] - rho[..., None]) ** 2 + (zg[:, None, :] - z[..., None]) ** 2
         idx = np.argmin(d, axis=-1)
         a1, b1 = self.sa[idx], self.sb[idx]
         a1, b1, p, _, ok = circle_hit(self.fm1, T[:, None], a1, b1, rho, z)
@@ -441,12 +447,15 @@ class TCA:
         ok = (n >= 2) & (fm <= f + tol)
         return np.where(ok[:, None], np.stack([x[:, 0], vm], -1), x)
 
-    def _refine_edge(self, T: Array, e: Array, t: Array, f: Array) -> tuple[Array, Array]:
+    def _refine_edge(
+        self, T: Array, e: Array, t: Array, f: Array, rz: tuple[Array, Array] | None = None
+    ) -> tuple[Array, Array]:
         h = np.full(t.shape, 1.0 / (len(self.et) - 1))
         o = np.array([-1.0, -0.5, 0.5, 1.0])
+        rz = self._search_rz(T) if rz is None else rz
         for _ in range(18):
             tt = np.clip(t[:, None] + o * h[:, None], 0.0, 1.0)
-            fs = self._theta_edge(T, np.broadcast_to(e[:, None], tt.shape), tt)[0]
+            fs = self._theta_edge(T, np.broadcast_to(e[:, None], tt.shape), tt, rz)[0]
             k = np.argmin(fs, -1)
             fb = fs[np.arange(len(k)), k]
             better = fb < f
@@ -481,17 +490,21 @@ class TCA:
         ne = len(self.et)
         e_all = np.repeat(np.arange(len(self.edges)), ne)
         t_all = np.tile(self.et, len(self.edges))
+        rz = self._search_rz(T)
         te = self._theta_edge(
-            T, np.broadcast_to(e_all, (C, e_all.size)), np.broadcast_to(t_all, (C, t_all.size))
+            T,
+            np.broadcast_to(e_all, (C, e_all.size)),
+            np.broadcast_to(t_all, (C, t_all.size)),
+            rz,
         )[0]
         ke = np.argmin(te, -1)
         ee, tb = e_all[ke], t_all[ke]
-        tb, fe = self._refine_edge(T, ee, tb, te[np.arange(C), ke])
+        tb, fe = self._refine_edge(T, ee, tb, te[np.arange(C), ke], rz)
         use_edge = fe < fp - 1e-13
         theta = np.minimum(fp, fe).reshape(n, P)
         # contact points of each pair
         _, _, _, uv2p = self._theta_pinion(T, xp[:, None, 0], xp[:, None, 1])
-        _, uv1e, uv2e = self._theta_edge(T, ee[:, None], tb[:, None])
+        _, uv1e, uv2e = self._theta_edge(T, ee[:, None], tb[:, None], rz)
         uv1 = np.where(use_edge[:, None], uv1e[:, 0], xp).reshape(n, P, 2)
         uv2 = np.where(use_edge[:, None], uv2e[:, 0], uv2p[:, 0]).reshape(n, P, 2)
         gear_edge = np.where(use_edge, ee, -1).reshape(n, P)
@@ -611,11 +624,21 @@ class TCA:
         Tc = self._tooth_frames(np.array([phi1]), np.array([ts]))[0]
         M1 = a.placement1(phi1)
         out = []
-        for i in np.nonzero(valid)[0]:
-            T = Tc[i]
-            Q, NQ = apply_points(T, self.cP), apply_vectors(T, self.cN)
+        idx = np.nonzero(valid)[0]
+        QN = [(apply_points(Tc[i], self.cP), apply_vectors(Tc[i], self.cN)) for i in idx]
+        if self.fm2.pointwise and len(idx) > 1:
+            # one Newton solve for the lines of all the pairs (each line iterates on its own:
+            # the same numbers as a solve per pair, with a pointwise flank map)
+            Q, NQ = np.stack([q for q, _ in QN]), np.stack([nq for _, nq in QN])
             a2, b2 = self.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
-            a2, b2, s, p2, n2, ok = line_hit(self.fm2, a2, b2, Q, NQ)
+            hit = line_hit(self.fm2, a2, b2, Q, NQ)
+            hits = [tuple(x[m] for x in hit) for m in range(len(idx))]
+        else:
+            hits = []
+            for Q, NQ in QN:
+                a2, b2 = self.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
+                hits.append(line_hit(self.fm2, a2, b2, Q, NQ))
+        for i, (_, NQ), (a2, b2, s, p2, n2, ok) in zip(idx, QN, hits, strict=True):
             u2, v2 = self.fm2.flank(a2, b2, p2)
             ok = ok & in_bounds(self.fm2, u2, v2)
             pdot = -a.sense2 * np.stack([-p2[..., 1], p2[..., 0], np.zeros_like(s)], -1)

@@ -28,6 +28,16 @@ Array = NDArray[np.float64]
 TOL_MM = 1e-10
 
 
+_FMAX = np.finfo(float).max
+
+
+def _finite(x: Array) -> Array:
+    """``np.nan_to_num(x)`` (NaN → 0, ±inf → ± the largest float) without its per-call
+    overhead (the Newton steps' small arrays)."""
+    x = np.where(np.isnan(x), 0.0, x)
+    return np.clip(x, -_FMAX, _FMAX, out=x)
+
+
 def _map(T: Array | None, p: Array, vec: bool = False) -> Array:
     if T is None:
         return p
@@ -83,8 +93,7 @@ def circle_hit(
             break
         aa, bb = a[act], b[act]
         Ta = None if Tf is None else Tf[act]
-        p0, _ = fm.evaluate(aa, bb)
-        ra, rb = fm.jacobian(aa, bb, p0)
+        p0, _, ra, rb = fm.point_jacobian(aa, bb)
         p = _map(Ta, p0)
         ra, rb = _map(Ta, ra, True), _map(Ta, rb, True)
         rho = np.hypot(p[..., 0], p[..., 1])
@@ -100,8 +109,8 @@ def circle_hit(
         j21, j22 = ra[..., 2], rb[..., 2]
         det = j11 * j22 - j12 * j21
         det = np.where(np.abs(det) > 1e-300, det, 1e-300)
-        da = np.nan_to_num(-(j22 * F1 - j12 * F2) / det)
-        db = np.nan_to_num(-(j11 * F2 - j21 * F1) / det)
+        da = _finite(-(j22 * F1 - j12 * F2) / det)
+        db = _finite(-(j11 * F2 - j21 * F1) / det)
         # trust region: at most a quarter of the working box per step
         sc = np.maximum(
             1.0, np.maximum(np.abs(da) / (0.25 * span[0]), np.abs(db) / (0.25 * span[1]))
@@ -147,19 +156,18 @@ def line_hit(
     for _ in range(max_iter):
         if act.size == 0:
             break
-        pa, na = fm.evaluate(a[act], b[act])
+        pa, na, ra, rb = fm.point_jacobian(a[act], b[act])
         p[act], n[act] = pa, na
         F = pa - P3[act] - s[act, None] * N3[act]
         going = np.linalg.norm(F, axis=-1) >= TOL_MM  # (NaN: stops, and fails the check below)
         if not going.any():
             act = act[:0]
             break
-        ra, rb = fm.jacobian(a[act], b[act], pa)  # (the same pa: maps that cache tangents)
         J = np.stack([ra[going], rb[going], -N3[act[going]]], -1)
         act = act[going]
         # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
         dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[going][..., None])[..., 0]
-        dx = np.nan_to_num(dx)
+        dx = _finite(dx)
         sc = np.maximum(
             1.0,
             np.maximum(

@@ -37,6 +37,7 @@ it is an acceleration, added by registering its class under the name the member 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -114,12 +115,33 @@ class FlankMap:
         hi = np.array([max(a0), max(b0)])
         return lo, hi
 
+    #: The evaluation is point by point (closed forms): the points of one call do not change
+    #: each other's result, so several sets of points may be evaluated in one call
+    #: (:meth:`point_jacobian`); not so for the engine's solves (:class:`GenericFlankMap`).
+    pointwise: ClassVar[bool] = False
+
     def jacobian(self, a: Array, b: Array, p: Array) -> tuple[Array, Array]:
         """``∂p/∂a``, ``∂p/∂b`` by forward differences ``(..., 3)`` each."""
         ha, hb = self.step
         pa = self.evaluate(a + ha, b)[0]
         pb = self.evaluate(a, b + hb)[0]
         return (pa - p) / ha, (pb - p) / hb
+
+    def point_jacobian(self, a: Array, b: Array) -> tuple[Array, Array, Array, Array]:
+        """``(p, n, ∂p/∂a, ∂p/∂b)`` at ``(a, b)`` (same shape): :meth:`evaluate` and
+        :meth:`jacobian` at once. A :attr:`pointwise` map with the forward differences of
+        :meth:`jacobian` evaluates ``(a, b)``, ``(a + h_a, b)`` and ``(a, b + h_b)`` in one
+        call (the same numbers: one call instead of three on the Newton solves' small
+        batches)."""
+        if self.pointwise and type(self).jacobian is FlankMap.jacobian:
+            a, b = np.asarray(a, float), np.asarray(b, float)
+            ha, hb = self.step
+            P, N = self.evaluate(np.stack([a, a + ha, a]), np.stack([b, b, b + hb]))
+            p = P[0]
+            return p, N[0], (P[1] - p) / ha, (P[2] - p) / hb
+        p, n = self.evaluate(a, b)
+        ra, rb = self.jacobian(a, b, p)
+        return p, n, ra, rb
 
 
 class GenericFlankMap(FlankMap):
@@ -129,6 +151,8 @@ class GenericFlankMap(FlankMap):
 @dataclass(frozen=True)
 class SpurInvoluteMap(FlankMap):
     """Closed-form unmodified spur involute; native ``(ε, z)`` with ``ε = tan α_y``."""
+
+    pointwise: ClassVar[bool] = True
 
     def _coef(self) -> tuple[float, float, float, float]:
         c = self._cache.get("coef")
@@ -186,22 +210,48 @@ class HelicoidMap(FlankMap):
         _, _, pu, pv = self.member.helicoid(self.side, a, b)
         return pu, pv
 
+    def point_jacobian(self, a, b):
+        # the closed form gives the tangents with the point: one evaluation
+        return self.member.helicoid(self.side, a, b)
+
 
 @dataclass(frozen=True)
 class FaceGearMap(FlankMap):
     """Closed-form face gear (γ = 90°); native ``(t, ψ)`` shaper roll and shaper angle."""
 
+    pointwise: ClassVar[bool] = True
+
     def _consts(self):
-        d = self.member.design
-        sg = -1.0 if self.side == "drive" else 1.0
-        ns, n2, m = d.n_shaper, d.n_face_gear, d.module_mm
-        al = np.radians(d.pressure_angle_deg)
-        return sg, ns, n2, 0.5 * ns * m * np.cos(al), 0.5 * ns * m, ns / n2, al
+        c = self._cache.get("consts")
+        if c is None:
+            d = self.member.design
+            sg = -1.0 if self.side == "drive" else 1.0
+            ns, n2, m = d.n_shaper, d.n_face_gear, d.module_mm
+            al = np.radians(d.pressure_angle_deg)
+            c = (sg, ns, n2, 0.5 * ns * m * np.cos(al), 0.5 * ns * m, ns / n2, al)
+            self._cache["consts"] = c
+        return c
+
+    def _terms(self):
+        """The constant terms of :meth:`evaluate`, each computed as there (left to right):
+        ``π/(2 N_s) + tan α − α``, ``−σ r_b``, ``σ π / N_2``."""
+        k = self._cache.get("terms")
+        if k is None:
+            sg, ns, n2, rb, rps, q, al = self._consts()
+            k = (np.pi / (2 * ns) + np.tan(al) - al, -sg * rb, sg * np.pi / n2)
+            self._cache["terms"] = k
+        return k
 
     def evaluate(self, a, b):
+        # shaper involute point (x_s, y_s) and normal at roll t, turned by ψ about the shaper
+        # axis; X = u_s from the meshing condition, then the face gear's turn q ψ + σ π / N_2.
+        # The outputs are filled in place (no stacks of the coordinate arrays).
         sg, ns, n2, rb, rps, q, al = self._consts()
-        t, psi = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
-        be = np.pi / (2 * ns) + np.tan(al) - al - t
+        e0, srb, c0 = self._terms()
+        t, psi = np.asarray(a, float), np.asarray(b, float)
+        if t.shape != psi.shape:
+            t, psi = np.broadcast_arrays(t, psi)
+        be = e0 - t
         cb, sb = np.cos(be), np.sin(be)
         xs = rb * (cb - t * sb)
         ys = sg * rb * (sb + t * cb)
@@ -211,12 +261,17 @@ class FaceGearMap(FlankMap):
         xr = xs * cp - ys * sp
         ny = nxs * sp + nys * cp
         nx = nxs * cp - nys * sp
-        us = -sg * rb / (q * ny)
-        X, Y, Z = us, yr, rps - xr
-        c = q * psi + sg * np.pi / n2
+        X = srb / (q * ny)
+        c = q * psi + c0
         cc, sc = np.cos(c), np.sin(c)
-        p = np.stack([X * cc + Y * sc, -X * sc + Y * cc, Z], -1)
-        n = np.stack([ny * sc, ny * cc, -nx], -1)
+        p = np.empty(t.shape + (3,))
+        p[..., 0] = X * cc + yr * sc
+        p[..., 1] = -X * sc + yr * cc
+        p[..., 2] = rps - xr
+        n = np.empty(t.shape + (3,))
+        n[..., 0] = ny * sc
+        n[..., 1] = ny * cc
+        n[..., 2] = -nx
         return p, n
 
     def flank(self, a, b, p):
