@@ -136,7 +136,10 @@ class FlankMap:
         if self.pointwise and type(self).jacobian is FlankMap.jacobian:
             a, b = np.asarray(a, float), np.asarray(b, float)
             ha, hb = self.step
-            P, N = self.evaluate(np.stack([a, a + ha, a]), np.stack([b, b, b + hb]))
+            ab = np.empty((2, 3) + np.broadcast_shapes(a.shape, b.shape))
+            ab[0, 0], ab[0, 1], ab[0, 2] = a, a + ha, a
+            ab[1, 0], ab[1, 1], ab[1, 2] = b, b, b + hb
+            P, N = self.evaluate(ab[0], ab[1])
             p = P[0]
             return p, N[0], (P[1] - p) / ha, (P[2] - p) / hb
         p, n = self.evaluate(a, b)
@@ -188,12 +191,21 @@ class SpurInvoluteMap(FlankMap):
 
     def evaluate(self, a, b):
         _, _, psi_b, rb = self._coef()
-        eps, z = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+        eps, z = np.asarray(a, float), np.asarray(b, float)
+        if eps.shape != z.shape:
+            eps, z = np.broadcast_arrays(eps, z)
         lam = psi_b - eps
         c, s = np.cos(lam), np.sin(lam)
         sg = 1.0 if self.side == "drive" else -1.0
-        p = np.stack([rb * (c - eps * s), sg * rb * (s + eps * c), z], -1)
-        n = np.stack([-s, sg * c, np.zeros_like(z)], -1)
+        # filled in place (no stacks of the coordinate arrays)
+        p = np.empty(eps.shape + (3,))
+        p[..., 0] = rb * (c - eps * s)
+        p[..., 1] = sg * rb * (s + eps * c)
+        p[..., 2] = z
+        n = np.empty(eps.shape + (3,))
+        n[..., 0] = -s
+        n[..., 1] = sg * c
+        n[..., 2] = 0.0
         return p, n
 
 
