@@ -386,6 +386,12 @@ class TCA:
         h = np.broadcast_to(self.step1, x.shape).copy()
         hmin = 1e-10 * (hi - lo)
         o = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], float)  # (9, 2)
+        ring = np.array([0, 1, 2, 3, 5, 6, 7, 8])  # the stencil without its centre (o[4] = 0)
+        # θ at a pinion point is a function of the point alone when the pinion's native
+        # parameters and points and the gear's points are computed point by point (each point's
+        # circle Newton stops on its own): then the gap at the centre is f, as it was found
+        fm1, fm2 = self.fm1, self.fm2
+        centre_known = fm1.pointwise and fm1.native_pointwise and fm2.pointwise
         act = np.arange(len(x))
         for _ in range(self.opt.refine_iter):
             act = act[np.any(h[act] > hmin, -1)]
@@ -393,7 +399,14 @@ class TCA:
                 break
             xa, fa, ha, Ta = x[act], f[act], h[act], T[act]
             pts = np.clip(xa[:, None, :] + o[None] * ha[:, None, :], lo, hi)  # (c, 9, 2)
-            fs = self._theta_pinion(Ta, pts[..., 0], pts[..., 1])[0]
+            if centre_known:
+                # the centre is the current point, whose gap f is known (θ is a function of
+                # the point alone): not evaluated again
+                fs = np.empty(pts.shape[:2])
+                fs[:, ring] = self._theta_pinion(Ta, pts[:, ring, 0], pts[:, ring, 1])[0]
+                fs[:, 4] = fa
+            else:
+                fs = self._theta_pinion(Ta, pts[..., 0], pts[..., 1])[0]
             # least-squares quadratic model in normalised offsets, Newton step (<= 4 steps)
             s = (pts - xa[:, None, :]) / ha[:, None, :]
             D = np.stack([np.ones_like(s[..., 0]), s[..., 0], s[..., 1], s[..., 0] ** 2,

@@ -115,10 +115,13 @@ class FlankMap:
         hi = np.array([max(a0), max(b0)])
         return lo, hi
 
-    #: The evaluation is point by point (closed forms): the points of one call do not change
-    #: each other's result, so several sets of points may be evaluated in one call
-    #: (:meth:`point_jacobian`); not so for the engine's solves (:class:`GenericFlankMap`).
+    #: :meth:`evaluate` and :meth:`flank` work point by point (closed forms): the points of one
+    #: call do not change each other's result, so several sets of points may be evaluated in
+    #: one call (:meth:`point_jacobian`); not so for solves that stop when all their points have
+    #: converged (the engine's, :class:`GenericFlankMap`; the spiral bevel's ψ).
     pointwise: ClassVar[bool] = False
+    #: :meth:`native` works point by point too (an affine map; not the face gear's inversion).
+    native_pointwise: ClassVar[bool] = False
 
     def jacobian(self, a: Array, b: Array, p: Array) -> tuple[Array, Array]:
         """``∂p/∂a``, ``∂p/∂b`` by forward differences ``(..., 3)`` each."""
@@ -156,6 +159,7 @@ class SpurInvoluteMap(FlankMap):
     """Closed-form unmodified spur involute; native ``(ε, z)`` with ``ε = tan α_y``."""
 
     pointwise: ClassVar[bool] = True
+    native_pointwise: ClassVar[bool] = True
 
     def _coef(self) -> tuple[float, float, float, float]:
         c = self._cache.get("coef")
