@@ -304,7 +304,9 @@ class TCA:
         sample, and the third evaluation of the exact flank is made only for the others (one
         process: line_hit 3.45-3.67 → 3.13-3.35 s).
         """
-        rz = np.stack(np.broadcast_arrays(rho, z), -1)
+        rho, z = np.asarray(rho), np.asarray(z)
+        rz = np.empty(np.broadcast_shapes(rho.shape, z.shape) + (2,))
+        rz[..., 0], rz[..., 1] = rho, z
         ab = self._gear_interp(rz)
         out = ~np.isfinite(ab).all(axis=-1)
         if out.any():
