@@ -84,12 +84,18 @@ def circle_hit(
     lo, hi = lo - 0.5 * span, hi + 0.5 * span
     act = np.arange(a.size)
     prev = np.full(a.size, np.inf)
+    # a pointwise map keeps the point and normal of the evaluation at which each point stops
+    # (its parameters do not move after it): the final evaluation is made only for the points
+    # still moving when the iterations run out
+    keep = fm.pointwise
+    if keep:
+        p_end, n_end = np.empty((a.size, 3)), np.empty((a.size, 3))
     for it in range(max_iter):
         if act.size == 0:
             break
         aa, bb = a[act], b[act]
         Ta = None if Tf is None else Tf[act]
-        p0, _, ra, rb = fm.point_jacobian(aa, bb)
+        p0, n0, ra, rb = fm.point_jacobian(aa, bb)
         p = _map(Ta, p0)
         ra, rb = _map(Ta, ra, True), _map(Ta, rb, True)
         rho = np.hypot(p[..., 0], p[..., 1])
@@ -113,8 +119,15 @@ def circle_hit(
         )
         a[act] = np.where(done, aa, np.clip(aa + da / sc, lo[0], hi[0]))
         b[act] = np.where(done, bb, np.clip(bb + db / sc, lo[1], hi[1]))
+        if keep:
+            p_end[act[done]], n_end[act[done]] = p0[done], n0[done]
         act = act[~done]
-    p0, n0 = fm.evaluate(a, b)
+    if keep:
+        if act.size:
+            p_end[act], n_end[act] = fm.evaluate(a[act], b[act])
+        p0, n0 = p_end, n_end
+    else:
+        p0, n0 = fm.evaluate(a, b)
     p, n = _map(Tf, p0), _map(Tf, n0, True)
     res = np.hypot(np.hypot(p[..., 0], p[..., 1]) - rho_t, p[..., 2] - z_t)
     ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
