@@ -258,37 +258,63 @@ class FaceGearMap(FlankMap):
             self._cache["terms"] = k
         return k
 
-    def evaluate(self, a, b):
-        # shaper involute point (x_s, y_s) and normal at roll t, turned by ψ about the shaper
-        # axis; X = u_s from the meshing condition, then the face gear's turn q ψ + σ π / N_2.
-        # The outputs are filled in place (no stacks of the coordinate arrays).
-        sg, ns, n2, rb, rps, q, al = self._consts()
-        e0, srb, c0 = self._terms()
-        t, psi = np.asarray(a, float), np.asarray(b, float)
-        if t.shape != psi.shape:
-            t, psi = np.broadcast_arrays(t, psi)
-        be = e0 - t
+    def _roll(self, t: Array) -> tuple[Array, Array, Array, Array]:
+        """The shaper involute at roll ``t``: point ``(x_s, y_s)`` and normal."""
+        sg, _, _, rb, _, _, _ = self._consts()
+        be = self._terms()[0] - t
         cb, sb = np.cos(be), np.sin(be)
-        xs = rb * (cb - t * sb)
-        ys = sg * rb * (sb + t * cb)
-        nxs, nys = sb, -sg * cb
-        cp, sp = np.cos(psi), np.sin(psi)
+        return rb * (cb - t * sb), sg * rb * (sb + t * cb), sb, -sg * cb
+
+    def _turn(self, psi: Array) -> tuple[Array, Array, Array, Array]:
+        """``cos``, ``sin`` of the shaper angle ``ψ`` and of the face gear's ``q ψ + σ π / N_2``."""
+        q = self._consts()[5]
+        c = q * psi + self._terms()[2]
+        return np.cos(psi), np.sin(psi), np.cos(c), np.sin(c)
+
+    def _point(self, roll, turn) -> tuple[Array, Array]:
+        """The face gear point and normal of the shaper point ``roll`` turned by ``turn``: the
+        shaper point turned by ψ about the shaper axis, ``X = u_s`` from the meshing condition,
+        then the face gear's turn (filled in place, no stacks of the coordinate arrays)."""
+        _, _, _, _, rps, q, _ = self._consts()
+        xs, ys, nxs, nys = roll
+        cp, sp, cc, sc = turn
         yr = xs * sp + ys * cp
         xr = xs * cp - ys * sp
         ny = nxs * sp + nys * cp
         nx = nxs * cp - nys * sp
-        X = srb / (q * ny)
-        c = q * psi + c0
-        cc, sc = np.cos(c), np.sin(c)
-        p = np.empty(t.shape + (3,))
+        X = self._terms()[1] / (q * ny)
+        p = np.empty(np.shape(X) + (3,))
         p[..., 0] = X * cc + yr * sc
         p[..., 1] = -X * sc + yr * cc
         p[..., 2] = rps - xr
-        n = np.empty(t.shape + (3,))
+        n = np.empty(p.shape)
         n[..., 0] = ny * sc
         n[..., 1] = ny * cc
         n[..., 2] = -nx
         return p, n
+
+    def evaluate(self, a, b):
+        t, psi = np.asarray(a, float), np.asarray(b, float)
+        if t.shape != psi.shape:
+            t, psi = np.broadcast_arrays(t, psi)
+        return self._point(self._roll(t), self._turn(psi))
+
+    def point_jacobian(self, a, b):
+        # the forward differences' points (t + h_t, ψ) and (t, ψ + h_ψ) share the roll or the
+        # turn of (t, ψ): 2 of each instead of 3 (the same numbers as 3 evaluations)
+        t, psi = np.asarray(a, float), np.asarray(b, float)
+        if t.shape != psi.shape:
+            t, psi = np.broadcast_arrays(t, psi)
+        ht, hp = self.step
+        tt, pp = np.empty((2,) + t.shape), np.empty((2,) + t.shape)
+        tt[0], tt[1] = t, t + ht
+        pp[0], pp[1] = psi, psi + hp
+        sel_t, sel_p = [0, 1, 0], [0, 0, 1]
+        roll = tuple(x[sel_t] for x in self._roll(tt))
+        turn = tuple(x[sel_p] for x in self._turn(pp))
+        P, N = self._point(roll, turn)
+        p = P[0]
+        return p, N[0], (P[1] - p) / ht, (P[2] - p) / hp
 
     def flank(self, a, b, p):
         rho = np.hypot(p[..., 0], p[..., 1])
