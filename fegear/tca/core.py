@@ -627,7 +627,10 @@ class TCA:
 
         if not ellipses:
             return pool[0], None
-        if len(pool) == 1:
+        if len(pool) == 1 or not self.opt.pinion_torque_Nm:
+            # without a torque no ellipse has a Hertz p0 (all −1 below): the first of the pool,
+            # whose ellipse alone is computed (the loaded cycle's TCA: 13 of its 38 on the face
+            # gear were for the other pairs of a tie)
             return pool[0], ellipse(pool[0])
         ells = [ellipse(i) for i in pool]
         p0 = [e.hertz.p0_MPa if e.hertz is not None else -1.0 for e in ells]
