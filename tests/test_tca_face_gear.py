@@ -40,6 +40,27 @@ def test_closed_form_face_gear_matches_generated_surface():
         assert np.abs(n - n0).max() < 1e-12
 
 
+def test_point_jacobian_is_evaluate_and_jacobian_bit_for_bit():
+    """The Newton solves' one-call point and Jacobian (the forward-difference points sharing the
+    roll or the turn of the point; the pinion's stacked in one evaluation) are the numbers of
+    ``evaluate`` then ``jacobian``, whatever the batch."""
+    rng = np.random.default_rng(7)
+    pin = flank_map(PINION, "drive")
+    for fm in (flank_map(FG, "drive"), flank_map(FG, "coast"), pin):
+        lo, hi = fm.native_box()
+        a = rng.uniform(lo[0], hi[0], 37)
+        b = rng.uniform(lo[1], hi[1], 37)
+        p, n, ra, rb = fm.point_jacobian(a, b)
+        p0, n0 = fm.evaluate(a, b)
+        ra0, rb0 = fm.jacobian(a, b, p0)
+        for x, y in ((p, p0), (n, n0), (ra, ra0), (rb, rb0)):
+            assert x.tobytes() == y.tobytes()
+        for k in (0, 5, 36):  # one point alone
+            q, m, qa, qb = fm.point_jacobian(a[k], b[k])
+            for x, y in ((q, p0[k]), (m, n0[k]), (qa, ra0[k]), (qb, rb0[k])):
+                assert x.tobytes() == y.tobytes()
+
+
 def test_localized_contact(cycles):
     r = cycles[0.0]
     assert r.has_contact.all()

@@ -107,11 +107,26 @@ def _poly_coeffs(c: tuple[float, ...]) -> tuple[Array, Array, Array]:
     return out
 
 
+@functools.lru_cache(maxsize=256)
+def _poly_floats(c: tuple[float, ...]) -> tuple[tuple[float, ...], ...]:
+    """:func:`_poly_coeffs` as tuples of floats (for :func:`_horner`)."""
+    return tuple(tuple(float(v) for v in x) for x in _poly_coeffs(c))
+
+
+def _horner(c: tuple[float, ...], x: Array) -> Array:
+    """``np.polynomial.polynomial.polyval(x, c)`` by the same operations, ``c[-1] + 0 x`` then
+    ``c[k] + (...) x`` down to ``k = 0`` (the same numbers), without its per-call argument
+    conversions (the generation engine evaluates its motions ~10⁴ times per TCA)."""
+    v = c[-1] + x * 0
+    for ck in c[-2::-1]:
+        v = ck + v * x
+    return v
+
+
 def _poly(c: Sequence[float], psi: Array) -> tuple[Array, Array, Array]:
     """Value, first and second derivative of ``c0 + c1 ψ + c2 ψ² + ...``."""
-    c0, c1, c2 = _poly_coeffs(tuple(float(x) for x in c))
-    pv = np.polynomial.polynomial.polyval
-    return pv(psi, c0), pv(psi, c1), pv(psi, c2)
+    c0, c1, c2 = _poly_floats(tuple(float(x) for x in c))
+    return _horner(c0, psi), _horner(c1, psi), _horner(c2, psi)
 
 
 @dataclass(frozen=True)
@@ -317,7 +332,16 @@ def generate(
     # bracket: scan ±half_width, pick the sign change nearest psi0
     offs = np.linspace(-half_width, half_width, n_scan)
     grid = psi0[..., None] + offs
-    fg = np.stack([_meshing(ts, motion, grid[..., k])[0] for k in range(n_scan)], -1)
+    if 1 < u.size * n_scan < _BATCH_MIN:
+        # a small scan in one evaluation of the motion (the per-point products of
+        # Motion.matrices as in one call per scan point, the same numbers): the scan points one
+        # set after the other, the tool sample repeated for each
+        rep = ToolSample(*(np.tile(np.broadcast_to(z, u.shape + (3,)).reshape(-1, 3), (n_scan, 1))
+                           for z in (ts.r, ts.r_u, ts.r_t, ts.n, ts.n_u, ts.n_t)))  # fmt: skip
+        f = _meshing(rep, motion, np.moveaxis(grid, -1, 0).reshape(-1))[0]
+        fg = np.moveaxis(f.reshape((n_scan,) + u.shape), 0, -1)
+    else:
+        fg = np.stack([_meshing(ts, motion, grid[..., k])[0] for k in range(n_scan)], -1)
     change = np.signbit(fg[..., :-1]) != np.signbit(fg[..., 1:])
     dist = np.where(change, np.abs(0.5 * (offs[:-1] + offs[1:])), np.inf)
     k = np.argmin(dist, axis=-1)

@@ -304,7 +304,9 @@ class TCA:
         sample, and the third evaluation of the exact flank is made only for the others (one
         process: line_hit 3.45-3.67 → 3.13-3.35 s).
         """
-        rz = np.stack(np.broadcast_arrays(rho, z), -1)
+        rho, z = np.asarray(rho), np.asarray(z)
+        rz = np.empty(np.broadcast_shapes(rho.shape, z.shape) + (2,))
+        rz[..., 0], rz[..., 1] = rho, z
         ab = self._gear_interp(rz)
         out = ~np.isfinite(ab).all(axis=-1)
         if out.any():
@@ -350,15 +352,21 @@ class TCA:
             a[m], b[m] = sa(t[m]), sb(t[m])
         return a, b
 
-    def _theta_edge(self, T: Array, e: Array, t: Array):
-        """Angular gap of gear edge points (edge ``e``, parameter ``t``; shape ``(C, m)``)."""
+    def _search_rz(self, T: Array) -> tuple[Array, Array]:
+        """``(ρ, z)``, each ``(C, g)``: the pinion search-grid points in the gear tooth frames
+        ``T (C, 4, 4)`` (the start points of :meth:`_theta_edge`; one per set of frames)."""
+        Pg = apply_points(T[:, None], self.sP[None])  # (C, g, 3)
+        return np.hypot(Pg[..., 0], Pg[..., 1]), Pg[..., 2]
+
+    def _theta_edge(self, T: Array, e: Array, t: Array, rz: tuple[Array, Array] | None = None):
+        """Angular gap of gear edge points (edge ``e``, parameter ``t``; shape ``(C, m)``);
+        ``rz``: :meth:`_search_rz` of ``T`` when the caller has it (the edge search evaluates
+        the same frames 20 times)."""
         a2, b2 = self._edge_native(e, t)
         R = self.fm2.evaluate(a2, b2)[0]
         rho, z = np.hypot(R[..., 0], R[..., 1]), R[..., 2]
-        Pg = apply_points(T[:, None], self.sP[None])  # (C, g, 3)
-        d = (np.hypot(Pg[..., 0], Pg[..., 1])[:, None, :] - rho[..., None]) ** 2 + (
-            Pg[..., 2][:, None, :] - z[..., None]
-        ) ** 2
+        rg, zg = self._search_rz(T) if rz is None else rz
+        d = (rg[:, None, :] - rho[..., None]) ** 2 + (zg[:, None, :] - z[..., None]) ** 2
         idx = np.argmin(d, axis=-1)
         a1, b1 = self.sa[idx], self.sb[idx]
         a1, b1, p, _, ok = circle_hit(self.fm1, T[:, None], a1, b1, rho, z)
@@ -380,6 +388,12 @@ class TCA:
         h = np.broadcast_to(self.step1, x.shape).copy()
         hmin = 1e-10 * (hi - lo)
         o = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], float)  # (9, 2)
+        ring = np.array([0, 1, 2, 3, 5, 6, 7, 8])  # the stencil without its centre (o[4] = 0)
+        # θ at a pinion point is a function of the point alone when the pinion's native
+        # parameters and points and the gear's points are computed point by point (each point's
+        # circle Newton stops on its own): then the gap at the centre is f, as it was found
+        fm1, fm2 = self.fm1, self.fm2
+        centre_known = fm1.pointwise and fm1.native_pointwise and fm2.pointwise
         act = np.arange(len(x))
         for _ in range(self.opt.refine_iter):
             act = act[np.any(h[act] > hmin, -1)]
@@ -387,7 +401,14 @@ class TCA:
                 break
             xa, fa, ha, Ta = x[act], f[act], h[act], T[act]
             pts = np.clip(xa[:, None, :] + o[None] * ha[:, None, :], lo, hi)  # (c, 9, 2)
-            fs = self._theta_pinion(Ta, pts[..., 0], pts[..., 1])[0]
+            if centre_known:
+                # the centre is the current point, whose gap f is known (θ is a function of
+                # the point alone): not evaluated again
+                fs = np.empty(pts.shape[:2])
+                fs[:, ring] = self._theta_pinion(Ta, pts[:, ring, 0], pts[:, ring, 1])[0]
+                fs[:, 4] = fa
+            else:
+                fs = self._theta_pinion(Ta, pts[..., 0], pts[..., 1])[0]
             # least-squares quadratic model in normalised offsets, Newton step (<= 4 steps)
             s = (pts - xa[:, None, :]) / ha[:, None, :]
             D = np.stack([np.ones_like(s[..., 0]), s[..., 0], s[..., 1], s[..., 0] ** 2,
@@ -441,12 +462,15 @@ class TCA:
         ok = (n >= 2) & (fm <= f + tol)
         return np.where(ok[:, None], np.stack([x[:, 0], vm], -1), x)
 
-    def _refine_edge(self, T: Array, e: Array, t: Array, f: Array) -> tuple[Array, Array]:
+    def _refine_edge(
+        self, T: Array, e: Array, t: Array, f: Array, rz: tuple[Array, Array] | None = None
+    ) -> tuple[Array, Array]:
         h = np.full(t.shape, 1.0 / (len(self.et) - 1))
         o = np.array([-1.0, -0.5, 0.5, 1.0])
+        rz = self._search_rz(T) if rz is None else rz
         for _ in range(18):
             tt = np.clip(t[:, None] + o * h[:, None], 0.0, 1.0)
-            fs = self._theta_edge(T, np.broadcast_to(e[:, None], tt.shape), tt)[0]
+            fs = self._theta_edge(T, np.broadcast_to(e[:, None], tt.shape), tt, rz)[0]
             k = np.argmin(fs, -1)
             fb = fs[np.arange(len(k)), k]
             better = fb < f
@@ -481,17 +505,21 @@ class TCA:
         ne = len(self.et)
         e_all = np.repeat(np.arange(len(self.edges)), ne)
         t_all = np.tile(self.et, len(self.edges))
+        rz = self._search_rz(T)
         te = self._theta_edge(
-            T, np.broadcast_to(e_all, (C, e_all.size)), np.broadcast_to(t_all, (C, t_all.size))
+            T,
+            np.broadcast_to(e_all, (C, e_all.size)),
+            np.broadcast_to(t_all, (C, t_all.size)),
+            rz,
         )[0]
         ke = np.argmin(te, -1)
         ee, tb = e_all[ke], t_all[ke]
-        tb, fe = self._refine_edge(T, ee, tb, te[np.arange(C), ke])
+        tb, fe = self._refine_edge(T, ee, tb, te[np.arange(C), ke], rz)
         use_edge = fe < fp - 1e-13
         theta = np.minimum(fp, fe).reshape(n, P)
         # contact points of each pair
         _, _, _, uv2p = self._theta_pinion(T, xp[:, None, 0], xp[:, None, 1])
-        _, uv1e, uv2e = self._theta_edge(T, ee[:, None], tb[:, None])
+        _, uv1e, uv2e = self._theta_edge(T, ee[:, None], tb[:, None], rz)
         uv1 = np.where(use_edge[:, None], uv1e[:, 0], xp).reshape(n, P, 2)
         uv2 = np.where(use_edge[:, None], uv2e[:, 0], uv2p[:, 0]).reshape(n, P, 2)
         gear_edge = np.where(use_edge, ee, -1).reshape(n, P)
@@ -599,7 +627,10 @@ class TCA:
 
         if not ellipses:
             return pool[0], None
-        if len(pool) == 1:
+        if len(pool) == 1 or not self.opt.pinion_torque_Nm:
+            # without a torque no ellipse has a Hertz p0 (all −1 below): the first of the pool,
+            # whose ellipse alone is computed (the loaded cycle's TCA: 13 of its 38 on the face
+            # gear were for the other pairs of a tie)
             return pool[0], ellipse(pool[0])
         ells = [ellipse(i) for i in pool]
         p0 = [e.hertz.p0_MPa if e.hertz is not None else -1.0 for e in ells]
@@ -611,11 +642,21 @@ class TCA:
         Tc = self._tooth_frames(np.array([phi1]), np.array([ts]))[0]
         M1 = a.placement1(phi1)
         out = []
-        for i in np.nonzero(valid)[0]:
-            T = Tc[i]
-            Q, NQ = apply_points(T, self.cP), apply_vectors(T, self.cN)
+        idx = np.nonzero(valid)[0]
+        QN = [(apply_points(Tc[i], self.cP), apply_vectors(Tc[i], self.cN)) for i in idx]
+        if self.fm2.pointwise and len(idx) > 1:
+            # one Newton solve for the lines of all the pairs (each line iterates on its own:
+            # the same numbers as a solve per pair, with a pointwise flank map)
+            Q, NQ = np.stack([q for q, _ in QN]), np.stack([nq for _, nq in QN])
             a2, b2 = self.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
-            a2, b2, s, p2, n2, ok = line_hit(self.fm2, a2, b2, Q, NQ)
+            hit = line_hit(self.fm2, a2, b2, Q, NQ)
+            hits = [tuple(x[m] for x in hit) for m in range(len(idx))]
+        else:
+            hits = []
+            for Q, NQ in QN:
+                a2, b2 = self.gear_start(np.hypot(Q[..., 0], Q[..., 1]), Q[..., 2])
+                hits.append(line_hit(self.fm2, a2, b2, Q, NQ))
+        for i, (_, NQ), (a2, b2, s, p2, n2, ok) in zip(idx, QN, hits, strict=True):
             u2, v2 = self.fm2.flank(a2, b2, p2)
             ok = ok & in_bounds(self.fm2, u2, v2)
             pdot = -a.sense2 * np.stack([-p2[..., 1], p2[..., 0], np.zeros_like(s)], -1)

@@ -28,6 +28,12 @@ Array = NDArray[np.float64]
 TOL_MM = 1e-10
 
 
+def _finite(x: Array) -> Array:
+    """``np.nan_to_num(x)`` (NaN → 0, ±inf → ± the largest float): ``x`` itself when it is all
+    finite (the usual Newton step), without the per-call cost of ``nan_to_num``."""
+    return x if np.isfinite(x).all() else np.nan_to_num(x)
+
+
 def _map(T: Array | None, p: Array, vec: bool = False) -> Array:
     if T is None:
         return p
@@ -78,13 +84,18 @@ def circle_hit(
     lo, hi = lo - 0.5 * span, hi + 0.5 * span
     act = np.arange(a.size)
     prev = np.full(a.size, np.inf)
+    # a pointwise map keeps the point and normal of the evaluation at which each point stops
+    # (its parameters do not move after it): the final evaluation is made only for the points
+    # still moving when the iterations run out
+    keep = fm.pointwise
+    if keep:
+        p_end, n_end = np.empty((a.size, 3)), np.empty((a.size, 3))
     for it in range(max_iter):
         if act.size == 0:
             break
         aa, bb = a[act], b[act]
         Ta = None if Tf is None else Tf[act]
-        p0, _ = fm.evaluate(aa, bb)
-        ra, rb = fm.jacobian(aa, bb, p0)
+        p0, n0, ra, rb = fm.point_jacobian(aa, bb)
         p = _map(Ta, p0)
         ra, rb = _map(Ta, ra, True), _map(Ta, rb, True)
         rho = np.hypot(p[..., 0], p[..., 1])
@@ -100,16 +111,23 @@ def circle_hit(
         j21, j22 = ra[..., 2], rb[..., 2]
         det = j11 * j22 - j12 * j21
         det = np.where(np.abs(det) > 1e-300, det, 1e-300)
-        da = np.nan_to_num(-(j22 * F1 - j12 * F2) / det)
-        db = np.nan_to_num(-(j11 * F2 - j21 * F1) / det)
+        da = _finite(-(j22 * F1 - j12 * F2) / det)
+        db = _finite(-(j11 * F2 - j21 * F1) / det)
         # trust region: at most a quarter of the working box per step
         sc = np.maximum(
             1.0, np.maximum(np.abs(da) / (0.25 * span[0]), np.abs(db) / (0.25 * span[1]))
         )
         a[act] = np.where(done, aa, np.clip(aa + da / sc, lo[0], hi[0]))
         b[act] = np.where(done, bb, np.clip(bb + db / sc, lo[1], hi[1]))
+        if keep:
+            p_end[act[done]], n_end[act[done]] = p0[done], n0[done]
         act = act[~done]
-    p0, n0 = fm.evaluate(a, b)
+    if keep:
+        if act.size:
+            p_end[act], n_end[act] = fm.evaluate(a[act], b[act])
+        p0, n0 = p_end, n_end
+    else:
+        p0, n0 = fm.evaluate(a, b)
     p, n = _map(Tf, p0), _map(Tf, n0, True)
     res = np.hypot(np.hypot(p[..., 0], p[..., 1]) - rho_t, p[..., 2] - z_t)
     ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
@@ -147,19 +165,18 @@ def line_hit(
     for _ in range(max_iter):
         if act.size == 0:
             break
-        pa, na = fm.evaluate(a[act], b[act])
+        pa, na, ra, rb = fm.point_jacobian(a[act], b[act])
         p[act], n[act] = pa, na
         F = pa - P3[act] - s[act, None] * N3[act]
         going = np.linalg.norm(F, axis=-1) >= TOL_MM  # (NaN: stops, and fails the check below)
         if not going.any():
             act = act[:0]
             break
-        ra, rb = fm.jacobian(a[act], b[act], pa)  # (the same pa: maps that cache tangents)
         J = np.stack([ra[going], rb[going], -N3[act[going]]], -1)
         act = act[going]
         # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
         dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[going][..., None])[..., 0]
-        dx = np.nan_to_num(dx)
+        dx = _finite(dx)
         sc = np.maximum(
             1.0,
             np.maximum(
