@@ -92,19 +92,25 @@ def hybrid_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
     P1, P2 = P1.tocsc(), P2.tocsc()
     Q1, d1 = _probe(models.pinion, M1, x1, -n1, P1, models.depth_mm)
     Q2, d2 = _probe(models.gear, M2, x2, n1, P2, models.depth_mm)
-    ops = ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
+    # Q and P in each operator's DOF basis once (a block of cells reads its columns of them).
+    ops = [
+        (op, op.project(Q), op.project(P))
+        for op, Q, P in ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
+    ]
     ends = np.cumsum([0] + [c.n for c in cells])
     blocks = [slice(ends[i], ends[i + 1]) for i in range(len(cells))]
     C = np.zeros((int(ends[-1]), int(ends[-1])))
     # Between pairs: the plain surface coupling of both members (upper blocks, mirrored).
     for ia, sa in enumerate(blocks):
         for sb in blocks[ia + 1 :]:
-            C[sa, sb] = sum(cross_compliance(op, P[:, sa], P[:, sb]) for op, _, P in ops)
+            C[sa, sb] = sum(
+                cross_compliance(op, P[:, sa], P[:, sb], projected=True) for op, _, P in ops
+            )
             C[sb, sa] = C[sa, sb].T
     for c, sl in zip(cells, blocks, strict=True):
         S = np.zeros((c.n, c.n))
         for op, Q, P in ops:
-            Cf = cross_compliance(op, Q[:, sl], P[:, sl])
+            Cf = cross_compliance(op, Q[:, sl], P[:, sl], projected=True)
             S += 0.5 * (Cf + Cf.T)
         lay = tangent_layout(c.centers, c.centers, c.normals, c.edges)
         s0 = layout_influence(lay, 0.0, models.E, models.nu)
@@ -127,6 +133,13 @@ def hybrid_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
     return C
+
+
+def _column(y: np.ndarray) -> sp.csc_matrix:
+    """The dense column ``y`` (n, 1) as a sparse one (its non-zero entries, as
+    ``sp.csc_matrix(y)`` stores them, without a pass of SciPy's dense conversion)."""
+    nz = np.flatnonzero(y[:, 0])
+    return sp.csc_matrix((y[nz, 0], nz, np.array([0, nz.size])), shape=y.shape)
 
 
 def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.ndarray:
@@ -170,6 +183,7 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
     other = F[:, None] - own
     u = np.zeros(int(ends_r[-1]))
     for op, Q, R, P in ((models.pinion.op, Q1, R1, loads[0]), (models.gear.op, Q2, R2, loads[1])):
+        Q, R = op.project(Q), op.project(R)  # once for all pairs' readers
         at = 0
         for p, c in enumerate(readers):
             if c.n == 0:
@@ -179,7 +193,8 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
             w = np.zeros(c.n)
             for M, f in ((Q, own[:, p]), (R, other[:, p])):
                 if f.any():
-                    w += cross_compliance(op, M[:, sub], sp.csc_matrix(P @ f[:, None]))[:, 0]
+                    load = op.project(_column(P @ f[:, None]))
+                    w += cross_compliance(op, M[:, sub], load, projected=True)[:, 0]
             u[ends_r[p] : ends_r[p + 1]] += w
     # The layer compression of each member from the pair's own loaded cells.
     at = 0
