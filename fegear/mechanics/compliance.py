@@ -183,8 +183,13 @@ class CandidateOperator:
         e = np.repeat(np.arange(k.size), count)
         term = T.data[t] * M.data[e]
         je = j[e]
-        order = np.lexsort((t, je))  # by column of M, then T's stored order (rows ascending)
-        je, r, term = je[order], row_of[t[order]], term[order]
+        # by column of M, then T's stored order (rows ascending); usually already so (M's
+        # rows ascending in each column, and T's rows follow its columns)
+        key = je * np.int64(T.data.size) + t
+        if np.any(key[1:] < key[:-1]):
+            order = np.argsort(key, kind="stable")
+            je, t, term = je[order], t[order], term[order]
+        r = row_of[t]
         new = np.ones(je.size, dtype=bool)
         new[1:] = (je[1:] != je[:-1]) | (r[1:] != r[:-1])
         group = np.cumsum(new) - 1
