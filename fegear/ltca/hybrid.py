@@ -40,7 +40,7 @@ import scipy.sparse as sp
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.ltca.model import cell_load_operators
 from fegear.mechanics.compliance import SurfacePoints, cross_compliance, find_tets, probe_operator
-from fegear.mechanics.halfspace import layout_influence, tangent_layout
+from fegear.mechanics.halfspace import layout_influence, layout_influences, tangent_layout
 
 __all__ = ["hybrid_compliance", "hybrid_displacement", "refined_sizes"]
 
@@ -113,20 +113,36 @@ def hybrid_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
             Cf = cross_compliance(op, Q[:, sl], P[:, sl], projected=True)
             S += 0.5 * (Cf + Cf.T)
         lay = tangent_layout(c.centers, c.centers, c.normals, c.edges)
-        s0 = layout_influence(lay, 0.0, models.E, models.nu)
-        full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
+        # the surface and every depth read by more than a quarter of the rows of a member, in
+        # one pass over the layout (full: depth -> all rows, shared by both members)
+        need = sorted(
+            {
+                float(dp)
+                for dd in (d1[sl], d2[sl])
+                for dp in np.unique(dd)
+                if dp != 0.0 and np.count_nonzero(dd == dp) > c.n // 4
+            }
+        )
+        s0, *rest = layout_influences(lay, [0.0, *need], models.E, models.nu)
+        full = dict(zip(need, rest, strict=True))
+        h0 = 0.5 * (s0 + s0.T)  # the same for both members
+        sym: dict[float, np.ndarray] = {}  # depth -> sym(sd) when every row is at that depth
         for dd in (d1[sl], d2[sl]):
-            S += 0.5 * (s0 + s0.T)
+            S += h0
             for depth in np.unique(dd):
                 rows = np.flatnonzero(dd == depth)
+                if rows.size == c.n and float(depth) in sym:  # the other member's, again
+                    S -= sym[float(depth)]
+                    continue
+                if rows.size == c.n:  # every row: sd is s0 or the full block, not a copy
+                    sd = s0 if depth == 0.0 else full[float(depth)]
+                    sym[float(depth)] = 0.5 * (sd + sd.T)
+                    S -= sym[float(depth)]
+                    continue
                 sd = np.zeros((c.n, c.n))
                 if depth == 0.0:
                     sd[rows] = s0[rows]
                 elif rows.size > c.n // 4:
-                    if float(depth) not in full:
-                        full[float(depth)] = layout_influence(
-                            lay, float(depth), models.E, models.nu
-                        )
                     sd[rows] = full[float(depth)][rows]
                 else:
                     sd[rows] = layout_influence(lay.rows(rows), float(depth), models.E, models.nu)
@@ -207,17 +223,15 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
             continue
         fl = F[ends_l[p] : ends_l[p + 1]]
         lay = tangent_layout(cr.centers, cl.centers, cl.normals, cl.edges)
-        s0 = layout_influence(lay, 0.0, models.E, models.nu) @ fl
-        done: dict[float, np.ndarray] = {}  # depth -> reading of every reader (both members)
+        # the surface and every matching depth of the readers (both members), in one pass
+        need = sorted({float(dp) for dp in np.unique(np.concatenate([d1[sub], d2[sub]]))} - {0.0})
+        s0, *rest = (m @ fl for m in layout_influences(lay, [0.0, *need], models.E, models.nu))
+        done = dict(zip(need, rest, strict=True))  # depth -> reading of every reader
         for dd in (d1[sub], d2[sub]):
             for depth in np.unique(dd):
                 if depth == 0.0:
                     continue  # read at the surface: no layer
                 k = np.flatnonzero(dd == depth)
-                if float(depth) not in done:
-                    done[float(depth)] = (
-                        layout_influence(lay, float(depth), models.E, models.nu) @ fl
-                    )
                 u[rows[k]] += s0[k] - done[float(depth)][k]
     return u
 
