@@ -25,6 +25,7 @@ from fegear.mechanics import halfspace
 from fegear.mechanics.halfspace import (
     halfspace_influence,
     layout_influence,
+    layout_influences,
     rectangle_integral,
     subsurface_influence,
     tangent_layout,
@@ -219,3 +220,20 @@ def test_tangent_layout_of_a_flat_grid_is_the_flat_layout() -> None:
         0.3,
     )
     np.testing.assert_allclose(layout_influence(lay, 0.2, 206000.0, 0.3), flat, rtol=1e-12)
+
+
+def test_influences_at_several_depths_are_the_single_depth_ones() -> None:
+    """:func:`layout_influences` shares what does not depend on the depth and nothing else: at
+    each depth its entries are those of :func:`layout_influence`, bit for bit (a layout large
+    enough for the row-block threads, and a small one)."""
+    rng = np.random.default_rng(3)
+    for m, n in ((40, 30), (150, 200)):
+        centres = np.c_[rng.uniform(-2.0, 2.0, (m, 2)), np.zeros(m)]
+        normals = np.tile([0.0, 0.0, 1.0], (m, 1))
+        edges = np.tile(np.array([[0.1, 0.0, 0.0], [0.0, 0.6, 0.0]]), (m, 1, 1))
+        points = np.c_[rng.uniform(-2.5, 2.5, (n, 2)), np.zeros(n)]
+        lay = tangent_layout(points, centres, normals, edges)
+        depths = [0.0, 0.35, 0.175]
+        for d, got in zip(depths, layout_influences(lay, depths, 206000.0, 0.3), strict=True):
+            want = layout_influence(lay, d, 206000.0, 0.3)
+            np.testing.assert_array_equal(got.view(np.int64), want.view(np.int64))

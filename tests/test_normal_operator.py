@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 import skfem
 
 from fegear.errors import InputError
@@ -124,6 +125,31 @@ def test_curved_face_difference_vanishes_with_curvature() -> None:
     assert rate >= 0.85, (diff, rate)
     # h / R = 1.7 / 10, a tighter bend than any flank's: the matrix moves by 0.2 %
     assert diff[0] < 1e-2, diff
+
+
+def test_projection_is_scipys_product_bit_for_bit() -> None:
+    """:meth:`CandidateOperator.project` forms ``T M`` on ``M``'s stored entries only, in
+    SciPy's order: the same entries, the same bits, as ``T @ M`` (the loads in CSR and CSC,
+    a block of their columns, a column with one force, and a load with cancelling terms)."""
+    _, P, _, turned = _operators(20.0)
+    T = turned.projection
+    f = np.zeros(P.shape[1])
+    f[[1, 5]] = [1.0, -1.0]
+    Pc = P.tocsc()
+    cases = [
+        P,
+        Pc,
+        Pc[:, 3:9],
+        sp.csc_matrix(P @ f[:, None]),
+        sp.csc_matrix(Pc[:, [2]] - Pc[:, [2]]),
+    ]
+    for M in cases:
+        want = sp.csc_matrix(T @ M)
+        got = turned.project(M)
+        assert got.shape == want.shape
+        np.testing.assert_array_equal(got.indptr, want.indptr)
+        np.testing.assert_array_equal(got.indices, want.indices)
+        np.testing.assert_array_equal(got.data.view(np.int64), want.data.view(np.int64))
 
 
 def test_normals_refused_on_partly_clamped_nodes() -> None:

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 from fegear.geometry.transforms import apply_points, apply_vectors, inverse
 from fegear.ltca.model import cell_load_operators
 from fegear.mechanics.compliance import SurfacePoints, cross_compliance, find_tets, probe_operator
-from fegear.mechanics.halfspace import layout_influence, tangent_layout
+from fegear.mechanics.halfspace import layout_influence, layout_influences, tangent_layout
 
 __all__ = ["hybrid_compliance", "hybrid_displacement", "refined_sizes"]
 
@@ -92,41 +92,70 @@ def hybrid_compliance(tca, pos, models, cells, loads=None) -> np.ndarray:
     P1, P2 = P1.tocsc(), P2.tocsc()
     Q1, d1 = _probe(models.pinion, M1, x1, -n1, P1, models.depth_mm)
     Q2, d2 = _probe(models.gear, M2, x2, n1, P2, models.depth_mm)
-    ops = ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
+    # Q and P in each operator's DOF basis once (a block of cells reads its columns of them).
+    ops = [
+        (op, op.project(Q), op.project(P))
+        for op, Q, P in ((models.pinion.op, Q1, P1), (models.gear.op, Q2, P2))
+    ]
     ends = np.cumsum([0] + [c.n for c in cells])
     blocks = [slice(ends[i], ends[i + 1]) for i in range(len(cells))]
     C = np.zeros((int(ends[-1]), int(ends[-1])))
     # Between pairs: the plain surface coupling of both members (upper blocks, mirrored).
     for ia, sa in enumerate(blocks):
         for sb in blocks[ia + 1 :]:
-            C[sa, sb] = sum(cross_compliance(op, P[:, sa], P[:, sb]) for op, _, P in ops)
+            C[sa, sb] = sum(
+                cross_compliance(op, P[:, sa], P[:, sb], projected=True) for op, _, P in ops
+            )
             C[sb, sa] = C[sa, sb].T
     for c, sl in zip(cells, blocks, strict=True):
         S = np.zeros((c.n, c.n))
         for op, Q, P in ops:
-            Cf = cross_compliance(op, Q[:, sl], P[:, sl])
+            Cf = cross_compliance(op, Q[:, sl], P[:, sl], projected=True)
             S += 0.5 * (Cf + Cf.T)
         lay = tangent_layout(c.centers, c.centers, c.normals, c.edges)
-        s0 = layout_influence(lay, 0.0, models.E, models.nu)
-        full: dict[float, np.ndarray] = {}  # depth -> all rows (shared by both members)
+        # the surface and every depth read by more than a quarter of the rows of a member, in
+        # one pass over the layout (full: depth -> all rows, shared by both members)
+        need = sorted(
+            {
+                float(dp)
+                for dd in (d1[sl], d2[sl])
+                for dp in np.unique(dd)
+                if dp != 0.0 and np.count_nonzero(dd == dp) > c.n // 4
+            }
+        )
+        s0, *rest = layout_influences(lay, [0.0, *need], models.E, models.nu)
+        full = dict(zip(need, rest, strict=True))
+        h0 = 0.5 * (s0 + s0.T)  # the same for both members
+        sym: dict[float, np.ndarray] = {}  # depth -> sym(sd) when every row is at that depth
         for dd in (d1[sl], d2[sl]):
-            S += 0.5 * (s0 + s0.T)
+            S += h0
             for depth in np.unique(dd):
                 rows = np.flatnonzero(dd == depth)
+                if rows.size == c.n and float(depth) in sym:  # the other member's, again
+                    S -= sym[float(depth)]
+                    continue
+                if rows.size == c.n:  # every row: sd is s0 or the full block, not a copy
+                    sd = s0 if depth == 0.0 else full[float(depth)]
+                    sym[float(depth)] = 0.5 * (sd + sd.T)
+                    S -= sym[float(depth)]
+                    continue
                 sd = np.zeros((c.n, c.n))
                 if depth == 0.0:
                     sd[rows] = s0[rows]
                 elif rows.size > c.n // 4:
-                    if float(depth) not in full:
-                        full[float(depth)] = layout_influence(
-                            lay, float(depth), models.E, models.nu
-                        )
                     sd[rows] = full[float(depth)][rows]
                 else:
                     sd[rows] = layout_influence(lay.rows(rows), float(depth), models.E, models.nu)
                 S -= 0.5 * (sd + sd.T)
         C[sl, sl] = S
     return C
+
+
+def _column(y: np.ndarray) -> sp.csc_matrix:
+    """The dense column ``y`` (n, 1) as a sparse one (its non-zero entries, as
+    ``sp.csc_matrix(y)`` stores them, without a pass of SciPy's dense conversion)."""
+    nz = np.flatnonzero(y[:, 0])
+    return sp.csc_matrix((y[nz, 0], nz, np.array([0, nz.size])), shape=y.shape)
 
 
 def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.ndarray:
@@ -170,6 +199,7 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
     other = F[:, None] - own
     u = np.zeros(int(ends_r[-1]))
     for op, Q, R, P in ((models.pinion.op, Q1, R1, loads[0]), (models.gear.op, Q2, R2, loads[1])):
+        Q, R = op.project(Q), op.project(R)  # once for all pairs' readers
         at = 0
         for p, c in enumerate(readers):
             if c.n == 0:
@@ -179,7 +209,8 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
             w = np.zeros(c.n)
             for M, f in ((Q, own[:, p]), (R, other[:, p])):
                 if f.any():
-                    w += cross_compliance(op, M[:, sub], sp.csc_matrix(P @ f[:, None]))[:, 0]
+                    load = op.project(_column(P @ f[:, None]))
+                    w += cross_compliance(op, M[:, sub], load, projected=True)[:, 0]
             u[ends_r[p] : ends_r[p + 1]] += w
     # The layer compression of each member from the pair's own loaded cells.
     at = 0
@@ -192,17 +223,15 @@ def hybrid_displacement(tca, pos, models, loaded, loads, forces, readers) -> np.
             continue
         fl = F[ends_l[p] : ends_l[p + 1]]
         lay = tangent_layout(cr.centers, cl.centers, cl.normals, cl.edges)
-        s0 = layout_influence(lay, 0.0, models.E, models.nu) @ fl
-        done: dict[float, np.ndarray] = {}  # depth -> reading of every reader (both members)
+        # the surface and every matching depth of the readers (both members), in one pass
+        need = sorted({float(dp) for dp in np.unique(np.concatenate([d1[sub], d2[sub]]))} - {0.0})
+        s0, *rest = (m @ fl for m in layout_influences(lay, [0.0, *need], models.E, models.nu))
+        done = dict(zip(need, rest, strict=True))  # depth -> reading of every reader
         for dd in (d1[sub], d2[sub]):
             for depth in np.unique(dd):
                 if depth == 0.0:
                     continue  # read at the surface: no layer
                 k = np.flatnonzero(dd == depth)
-                if float(depth) not in done:
-                    done[float(depth)] = (
-                        layout_influence(lay, float(depth), models.E, models.nu) @ fl
-                    )
                 u[rows[k]] += s0[k] - done[float(depth)][k]
     return u
 

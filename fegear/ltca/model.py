@@ -99,13 +99,15 @@ class MemberModel:
     def prepare(self) -> None:
         """Build the lazily made structures every mesh position reads: the point locators of
         the mesh and of the working flanks in the operator
-        (:func:`fegear.mechanics.compliance.prepare_locators`) and the operator's row and column
-        maps.
+        (:func:`fegear.mechanics.compliance.prepare_locators`), the operator's row and column
+        maps and its projection's columns.
         Called by a process before it forks the workers that solve the positions (each would
         otherwise build its own); the positions' numbers do not change."""
         teeth = range(self.sector.n_teeth) if self.teeth is None else self.teeth
         prepare_locators(self.body.mesh, [f"flank_{self.side}_{t}" for t in teeth])
         _ = self.op._row_map, self.op._col_maps
+        if self.op.projection is not None:
+            _ = self.op._projection_columns
 
 
 def build_member_model(
