@@ -18,3 +18,15 @@ def assert_refused(code: int, err: str, words) -> str:
     for w in words:
         assert w in line, f"{w!r} not in {line!r}"
     return line
+
+
+def summary_value(doc, dotted: str):
+    """The entry ``a.b.0.c`` of a ``summary.json`` document (digits index lists); fails naming
+    the key when it is missing."""
+    for k in dotted.split("."):
+        if k.isdigit():
+            doc = doc[int(k)]
+        else:
+            assert k in doc, f"summary.json has no {dotted!r}"
+            doc = doc[k]
+    return doc

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_checks import summary_value
 
 import fegear
 from fegear.case_files import parse_case
@@ -336,16 +337,6 @@ def fzg_run(tmp_path_factory):
     return code, out
 
 
-def _get(doc, dotted: str):
-    for k in dotted.split("."):
-        if k.isdigit():
-            doc = doc[int(k)]
-        else:
-            assert k in doc, f"summary.json has no {dotted!r}"
-            doc = doc[k]
-    return doc
-
-
 def test_fzg_run_writes_the_summary_keys(fzg_run):
     code, out = fzg_run
     assert code == 0
@@ -353,17 +344,18 @@ def test_fzg_run_writes_the_summary_keys(fzg_run):
     assert doc["kind"] == "spur" and doc["fidelity"] == "hybrid" and doc["level"] == 0
     for key in ("te_pp_unloaded_arcsec", "te_pp_loaded_arcsec", "contact_ratio_loaded",
                 "p_max_MPa"):  # fmt: skip
-        v = _get(doc, f"cycle.{key}")
+        v = summary_value(doc, f"cycle.{key}")
         assert isinstance(v, float) and math.isfinite(v), key
     assert len(doc["positions"]) == N_FZG
     # conjugate involute pair: no unloaded TE (invariant, to the TCA's round-off)
-    assert _get(doc, "cycle.te_pp_unloaded_arcsec") < 1e-6
+    assert summary_value(doc, "cycle.te_pp_unloaded_arcsec") < 1e-6
     # loaded: a lag (negative TE) at every position; one or two pairs (contact ratio 1.46)
-    assert 1.0 <= _get(doc, "cycle.contact_ratio_loaded") <= 2.0
+    assert 1.0 <= summary_value(doc, "cycle.contact_ratio_loaded") <= 2.0
     for i, pos in enumerate(doc["positions"]):
-        assert _get(pos, "te_loaded_arcsec") < 0
-        assert -12.0 <= _get(pos, "pinion_angle_deg") < 12.0  # one cycle, 360/16 = 22.5 deg
-        shares = [_get(q, "load_share") for q in pos["pairs"]]
+        assert summary_value(pos, "te_loaded_arcsec") < 0
+        # one cycle, 360/16 = 22.5 deg
+        assert -12.0 <= summary_value(pos, "pinion_angle_deg") < 12.0
+        shares = [summary_value(q, "load_share") for q in pos["pairs"]]
         # torque balance is enforced by the solver: round-off
         assert abs(sum(shares) - 1.0) < 1e-9, (i, shares)
         assert pos["solver"]["equilibrium_residual"] < 1e-9
@@ -382,19 +374,19 @@ def test_fzg_run_writes_the_summary_keys(fzg_run):
     assert doc["units"]["pressure"] == "MPa"
     # what the sectors modelled: every pair in contact at some position has a fine zone, and
     # 5 teeth hold the pairs -1, 0, +1 of a contact ratio of 1.46 with a neighbour each side
-    zone = _get(doc, "cycle.contact_zone")
+    zone = summary_value(doc, "cycle.contact_zone")
     modelled = {tuple(p) for p in zone["pairs"]}
     touching = {(q["pinion_tooth"], q["gear_tooth"]) for p in doc["positions"] for q in p["pairs"]}
     assert touching <= modelled and zone["sector_teeth"] == 5 and zone["gap_mm"] > 0
     # the headline p_max is the largest pressure away from the edges over the usable positions,
     # the edge value beside it (issue 21)
     usable = [p for p in doc["positions"] if p["status"] == "ok"]
-    assert _get(doc, "cycle.te_pp_loaded_positions_used") == len(usable) == N_FZG
-    assert _get(doc, "cycle.p_max_MPa") == max(
+    assert summary_value(doc, "cycle.te_pp_loaded_positions_used") == len(usable) == N_FZG
+    assert summary_value(doc, "cycle.p_max_MPa") == max(
         q["p_interior_MPa"] for p in usable for q in p["pairs"] if q["p_interior_MPa"] is not None
     )
     edge = [q["p_edge_MPa"] for p in usable for q in p["pairs"] if q["p_edge_MPa"] is not None]
-    assert _get(doc, "cycle.p_max_edge_MPa") == (max(edge) if edge else None)
+    assert summary_value(doc, "cycle.p_max_edge_MPa") == (max(edge) if edge else None)
 
 
 def test_fzg_pvd_reads_back_with_pyvista(fzg_run):

@@ -13,7 +13,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
-from cli_checks import assert_refused, one_line
+from cli_checks import assert_refused, one_line, summary_value
 
 from fegear.case_files import load_case
 from fegear.cli import main
@@ -108,36 +108,29 @@ def level0_run(tmp_path_factory):
     return code, out
 
 
-def _get(doc: dict, dotted: str):
-    for k in dotted.split("."):
-        assert k in doc, f"summary.json has no {dotted!r}"
-        doc = doc[k]
-    return doc
-
-
 def test_run_writes_the_summary(level0_run):
     code, out = level0_run
     assert code == 0
     doc = json.loads((out / "summary.json").read_text())
-    assert _get(doc, "inputs.force_N") == 2000.0
+    assert summary_value(doc, "inputs.force_N") == 2000.0
     # Principal radii of each body, [Rx, Ry]; the block is flat.
-    assert _get(doc, "inputs.radii_mm") == [[20.0, 100.0], [None, None]]
-    assert _get(doc, "inputs.E_MPa") == [206000.0, 206000.0]
-    assert _get(doc, "inputs.nu") == [0.3, 0.3]
+    assert summary_value(doc, "inputs.radii_mm") == [[20.0, 100.0], [None, None]]
+    assert summary_value(doc, "inputs.E_MPa") == [206000.0, 206000.0]
+    assert summary_value(doc, "inputs.nu") == [0.3, 0.3]
     for key in ("p0_MPa", "a_mm", "b_mm"):
-        fe, ref = _get(doc, "result." + key), _get(doc, "hertz." + key)
+        fe, ref = summary_value(doc, "result." + key), summary_value(doc, "hertz." + key)
         assert math.isfinite(fe) and ref > 0
         # Level 0 (6 cells across 2b) is within ~2.5 % of Hertz (see test_hertz_scene.py).
         assert abs(fe / ref - 1) < 0.04, (key, fe, ref)
     # The Hertz reference of the nominal scene (closed form, independent of the mesh).
-    assert _get(doc, "hertz.p0_MPa") == pytest.approx(1447.7, rel=1e-4)
-    assert _get(doc, "hertz.a_mm") == pytest.approx(1.3807, rel=1e-4)
-    assert _get(doc, "hertz.b_mm") == pytest.approx(0.47773, rel=1e-4)
-    assert _get(doc, "levels") == []  # no study asked for
+    assert summary_value(doc, "hertz.p0_MPa") == pytest.approx(1447.7, rel=1e-4)
+    assert summary_value(doc, "hertz.a_mm") == pytest.approx(1.3807, rel=1e-4)
+    assert summary_value(doc, "hertz.b_mm") == pytest.approx(0.47773, rel=1e-4)
+    assert summary_value(doc, "levels") == []  # no study asked for
     # The whole force is transmitted (the quarter model, scaled back).
-    assert _get(doc, "result.total_force_N") == pytest.approx(2000.0, rel=1e-9)
+    assert summary_value(doc, "result.total_force_N") == pytest.approx(2000.0, rel=1e-9)
     # Level 0 is too coarse for percent accuracy, and the summary says so.
-    assert any("cells across the minor axis" in w for w in _get(doc, "result.warnings"))
+    assert any("cells across the minor axis" in w for w in summary_value(doc, "result.warnings"))
 
 
 def test_run_writes_readable_vtu_files(level0_run):
