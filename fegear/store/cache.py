@@ -739,16 +739,24 @@ def find_record(
     ValueError
         ``kind`` has no producer.
     """
-    key = artefact_key(kind, params, producer)
+    return _lookup(kind, params, producer)[1]
+
+
+def _lookup(
+    kind: str, params: Mapping[str, object], producer: Producer | None
+) -> tuple[Entry, tuple[Entry, dict] | None]:
+    """``(entry, found)``: the entry of ``params`` (its key computed once) and, for a hit, what
+    :func:`find_record` returns (the hit counted and marked used), else None."""
+    key = artefact_key(kind, params, producer)  # a kind without a producer: refused first
     folder = cache_dir(kind)
     found = _read_record(folder, key)
     if found is None:
-        return None
+        return Entry(folder, key), None
     entry = Entry(folder, key, tuple(found[1]))
     log.info("cache hit %s/%s", kind, entry.record_path.name)
     _used(folder, key)
     _count(kind, True)
-    return entry, found[0]
+    return entry, (entry, found[0])
 
 
 def cached_record(
@@ -786,12 +794,10 @@ def cached_record(
         The entry (:meth:`Entry.path` of its data files), the record, and whether it came from
         the cache.
     """
-    found = find_record(kind, params, producer)  # a kind without a producer: refused first
+    entry, found = _lookup(kind, params, producer)
     if found is not None:
         return found[0], found[1], True
-    key = artefact_key(kind, params, producer)
-    folder = cache_dir(kind)
-    entry = Entry(folder, key)
+    key, folder = entry.key, entry.folder
     record = dict(build(entry))  # the data files, each written atomically
     paths = {f: entry.path(f) for f in entry.files}
     doc = {
