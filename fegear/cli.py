@@ -47,6 +47,7 @@ from fegear import __version__
 from fegear.errors import FegearError, InputError
 from fegear.export.command import add_parser as add_export
 from fegear.export.command import run as export_ccx
+from fegear.forked import process_count
 from fegear.store.cache import cache_info, check_cache_root, clear_cache
 from fegear.store.files import check_writable_folder, journal
 from fegear.store.outputs import MANIFEST, inspect_output_folder, run_files
@@ -132,7 +133,12 @@ def _parser() -> argparse.ArgumentParser:
         "overrides the cases",
     )
     s.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the cases")
-    s.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    s.add_argument(
+        "--workers",
+        type=int,
+        help="items computed side by side after the first, in processes sharing its models "
+        "(default: one per core, $FEGEAR_WORKERS); the results do not depend on it",
+    )
     s.add_argument(
         "--scheduler",
         metavar="ADDRESS",
@@ -507,8 +513,9 @@ def _sweep(args: argparse.Namespace) -> int:
     t_start = time.perf_counter()
     check_writable_folder(args.out)
     items = build_items(args.case, args.grid, fidelity=args.fidelity, level=args.level)
-    if args.workers < 1:
+    if args.workers is not None and args.workers < 1:
         raise InputError("--workers", args.workers, "an integer >= 1")
+    workers = process_count(args.workers, max(len(items) - 1, 1))
     names = [it.name for it in items]
     if args.nominal is not None and args.nominal not in names:
         raise InputError("--nominal", args.nominal, f"one of the item names {names}")
@@ -517,7 +524,7 @@ def _sweep(args: argparse.Namespace) -> int:
     where = (
         f"Dask scheduler {args.scheduler}"
         if args.scheduler
-        else f"{args.workers} local worker{'s' if args.workers > 1 else ''}"
+        else f"{workers} item{'s' if workers > 1 else ''} at a time"
     )
     grid = "".join(f" × {g}" for g in args.grid)
     say(
@@ -538,7 +545,7 @@ def _sweep(args: argparse.Namespace) -> int:
     res = run_sweep(
         items,
         args.out,
-        workers=args.workers,
+        workers=workers,
         scheduler=args.scheduler,
         nominal=args.nominal,
         progress=progress,

@@ -6,6 +6,7 @@ and compliance operators are cached; the first item of the session builds them, 
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -18,8 +19,12 @@ from pathlib import Path
 import pytest
 from cli_checks import assert_refused, one_line
 
+from fegear.case_files import load_case
 from fegear.cli import main
+from fegear.pipeline.run import check_case, run_gear_case
+from fegear.store.cache import record_cache_use
 from fegear.sweep import MARKER, build_items, parse_grid
+from fegear.sweep.local import run_local
 
 REPO = Path(__file__).resolve().parents[1]
 FZG = REPO / "cases" / "fzg_spur.toml"
@@ -393,3 +398,87 @@ def test_with_two_workers_the_first_item_builds_what_the_others_read(fzg3, tmp_p
     for b, h in zip(built[1:], hits[1:], strict=True):
         assert "mesh" not in b and "compliance" not in b, b
         assert h.get("mesh") == 2 and h.get("compliance", 0) >= 2, h
+
+
+# --------------------------------------------------------------------------------------------
+# The local execution: one warm worker, later items side by side, checks prepared beforehand
+# --------------------------------------------------------------------------------------------
+
+
+def _where(item: str, processes: int | None) -> tuple:
+    """``run_one`` of the tests below: which process ran ``item``, with how many processes."""
+    return item, processes, os.getpid(), os.getppid()
+
+
+def _failed(item: str, exc: BaseException) -> tuple:
+    return item, "failed", repr(exc)
+
+
+def test_later_items_run_side_by_side_in_forks_of_the_warm_worker():
+    """Five items, two at a time: the first alone in the worker (every core: ``None``), then
+    (b, c) and (d, e), the first of each group in the worker and the other in a process forked
+    from it (so it has the worker's models), each on one process; results in order."""
+    out = list(run_local(list("abcde"), _where, 2, _failed))
+    assert [o[0] for o in out] == list("abcde")
+    worker = out[0][2]
+    assert out[0][1] is None and worker != os.getpid()
+    for lead, other in (out[1:3], out[3:5]):
+        assert lead[2] == worker and lead[1] == 1, lead
+        assert other[3] == worker and other[2] != worker and other[1] == 1, other
+
+
+def test_one_worker_runs_the_items_one_after_the_other_on_every_core():
+    out = list(run_local(list("abc"), _where, 1, _failed))
+    assert [o[0] for o in out] == list("abc")
+    assert len({o[2] for o in out}) == 1 and all(o[1] is None for o in out), out
+
+
+def _mark(folder: str, item: str) -> None:
+    """``prepare`` of the test below: a file per item, with the preparing process."""
+    (Path(folder) / item).write_text(f"{os.getpid()} {os.getppid()}")
+
+
+def _wait_marked(folder: str, item: str, processes: int | None) -> tuple:
+    """``run_one``: the item's run waits (up to 20 s) for its preparation, as a real item
+    would read its checks from the cache."""
+    deadline = time.monotonic() + 20
+    while item != "a" and not (Path(folder) / item).exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return _where(item, processes)
+
+
+def test_later_items_are_prepared_beside_the_first(tmp_path, monkeypatch):
+    """``prepare`` runs for every item but the first, in one process forked from the worker
+    (beside the first item, which it does not delay: nothing waits for it); not where the
+    work keeps to one process (``FEGEAR_WORKERS=1``, as the other tests run)."""
+    monkeypatch.delenv("FEGEAR_WORKERS")
+    out = list(
+        run_local(
+            list("abcd"),
+            functools.partial(_wait_marked, str(tmp_path)),
+            2,
+            _failed,
+            functools.partial(_mark, str(tmp_path)),
+        )
+    )
+    worker = out[0][2]
+    marks = {p.name: p.read_text().split() for p in tmp_path.iterdir()}
+    assert sorted(marks) == ["b", "c", "d"]  # not the first item
+    (preparer,) = {pid for pid, _ in marks.values()}
+    assert {ppid for _, ppid in marks.values()} == {str(worker)} and preparer != str(worker)
+
+
+def test_a_prepared_item_reads_its_checks_from_the_cache(fzg3):
+    """:func:`check_case` keeps the TCA of the positions and the engagement checks (contact
+    path, handover) where the run of the same case finds them: the run reads every one of them
+    (the same keys) and builds none of the checks' kinds again (its own ``tca``: the closing of
+    the loaded cycle's phase, :mod:`fegear.ltca.cycle`, is not a check)."""
+    case = load_case(fzg3).with_errors(f_sigma_beta_mm=0.00731)  # an error no test uses
+    with record_cache_use() as used:
+        check_case(case)
+    checks = used().built
+    assert {"tca", "contact_path", "handover"} <= set(checks), checks
+    run = run_gear_case(case, fields=False)
+    for kind in ("contact_path", "handover"):
+        assert run.cache.hits.get(kind) == checks[kind] and kind not in run.cache.built
+    assert run.cache.hits.get("tca", 0) >= checks["tca"], run.cache

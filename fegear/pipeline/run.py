@@ -51,7 +51,7 @@ from fegear.tca.cycle import cycle_result
 from fegear.tca.ellipse import EllipseAt, ellipses
 from fegear.tca.results import ARCSEC, CycleResult
 
-__all__ = ["GearRun", "run_gear_case"]
+__all__ = ["GearRun", "check_case", "run_gear_case"]
 
 log = logging.getLogger(__name__)
 
@@ -269,6 +269,39 @@ def _ellipses(case: GearCase, tca, positions) -> tuple:
     return ellipses(positions, tca.asm.axis1(), T1, tca.opt.paint_mm, case.E_MPa, case.nu)
 
 
+def _loaded_checks(case: GearCase, pair: GearPair, clearance, opt: LTCAOptions):
+    """``(tca, positions, engagement)``: the TCA of a loaded run's positions
+    (:func:`fegear.ltca.cycle.cycle_tca`) and the engagement checks on them, both kept in the
+    cache."""
+    tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
+    eng = check_engagement(case, pair, tca, positions, clearance, opt.workers)
+    return tca, positions, eng
+
+
+def check_case(case: GearCase, workers: int | None = 1) -> Engagement | None:
+    """What :func:`run_gear_case` decides about ``case`` before any FE work: the pair built,
+    the tip clearance checked and, for a loaded fidelity, the TCA of the positions and the
+    engagement checks (:func:`fegear.pipeline.engagement.check_engagement`); returns their
+    :class:`~fegear.pipeline.engagement.Engagement` (None for the ``tca`` fidelity, whose run
+    is this work).
+
+    The TCA and the checks are kept in the artefact cache, so a run of the same case
+    afterwards reads them (a sweep prepares its later items this way while its first item
+    builds the models: :mod:`fegear.sweep.run`).
+
+    Raises
+    ------
+    InputError
+        As :func:`run_gear_case`: bad design data, or an installation under which the flanks
+        cannot mesh.
+    """
+    pair = build_pair(case)
+    clearance = check_clearance(case, pair)
+    if case.fidelity == UNLOADED:
+        return None
+    return _loaded_checks(case, pair, clearance, _ltca_options(case, workers))[2]
+
+
 def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields, reuse):
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
@@ -300,8 +333,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, field
 
     opt = _ltca_options(case, workers)
     t0 = time.perf_counter()
-    tca, positions, _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt)
-    eng = check_engagement(case, pair, tca, positions, clearance, workers)  # before the FE work
+    tca, positions, eng = _loaded_checks(case, pair, clearance, opt)  # before the FE work
     ell = _ellipses(case, tca, positions)
     for w in eng.warnings:
         (notify or log.warning)(w)

@@ -40,17 +40,16 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import functools
 import itertools
 import logging
 import math
 import os
 import shutil
-import sys
 import time
 import tomllib
 import uuid
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -58,13 +57,14 @@ from typing import Any
 from fegear import __version__
 from fegear.case_files import load_case, parse_case
 from fegear.errors import BackendUnavailable, FegearError, InputError
+from fegear.forked import process_count
 from fegear.io.gear_case import FIDELITIES, GEAR_KINDS, N_LEVELS, GearCase
-from fegear.output.figure import pyplot
 from fegear.output.gear_output import write_gear_outputs
-from fegear.pipeline.run import run_gear_case
+from fegear.pipeline.run import check_case, run_gear_case
 from fegear.store.cache import cache_root as _cache_root
 from fegear.store.cache import content_hash
 from fegear.store.files import write_json
+from fegear.sweep.local import run_local
 from fegear.sweep.marker import MARKER, digest, read_marker, verified_summary
 from fegear.sweep.output import comparison_error, write_sweep_json, write_sweep_outputs
 from fegear.units import TORQUE_KEYS
@@ -559,33 +559,6 @@ def _clean_tmp(out: Path) -> list[str]:
     return gone
 
 
-def _worker_init() -> None:  # pragma: no cover  (runs in the worker processes)
-    """Local worker: die with the sweep process (Linux), one BLAS thread per worker, and
-    matplotlib imported once: every item draws its pictures in a process forked from this one
-    (:func:`fegear.output.gear_output.write_gear_outputs`), which then finds it imported
-    instead of importing it again (about a second per item)."""
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-            import signal
-
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-        except Exception:  # noqa: BLE001  (best effort)
-            pass
-    pyplot()
-
-
-def _local_pool(workers: int) -> ProcessPoolExecutor:
-    import multiprocessing
-
-    # "spawn": fresh interpreters (no fork of a process holding BLAS or Dask threads)
-    return ProcessPoolExecutor(
-        max_workers=workers,
-        mp_context=multiprocessing.get_context("spawn"),
-        initializer=_worker_init,
-    )
-
-
 def _dask_client(address: str):
     require_dask()
     from distributed import Client
@@ -601,7 +574,7 @@ def _dask_client(address: str):
 def run_sweep(
     items: Sequence[SweepItem],
     out: str | Path,
-    workers: int = 1,
+    workers: int | None = None,
     scheduler: str | None = None,
     nominal: str | None = None,
     progress: Progress | None = None,
@@ -615,9 +588,10 @@ def run_sweep(
     out
         Sweep folder; item ``k`` goes to ``out/<name>/``.
     workers
-        Local worker processes (ignored with ``scheduler``); with more than one, the first item
-        to compute runs alone first (it builds the sector meshes and operators the others then
-        read), the others side by side.
+        Items computed side by side on this machine (ignored with ``scheduler``): all items
+        run in one worker process that keeps the models, the first alone on every core, the
+        others ``workers`` at a time in processes forked from it (:mod:`fegear.sweep.local`);
+        None: ``$FEGEAR_WORKERS``, else one per core. The items' results do not depend on it.
     scheduler
         Address of a Dask distributed scheduler (``tcp://host:8786``); Dask is imported only
         then.
@@ -637,8 +611,9 @@ def run_sweep(
         The scheduler cannot be reached, or another sweep holds the folder.
     """
     items = tuple(items)
-    if workers < 1:
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
         raise InputError("--workers", workers, "an integer >= 1")
+    workers = process_count(workers, max(len(items) - 1, 1))
     names = [it.name for it in items]
     if nominal is not None and nominal not in names:
         raise InputError("--nominal", nominal, f"one of the item names {names}")
@@ -700,32 +675,27 @@ def _execute(
         finally:
             client.close()
         return
-    if workers > 1 and len(todo) > 1:
-        # the first item alone, on every core: it builds the sector meshes and operators the
-        # others read (items started together would each build them); then the others
-        # side by side, each reading them from the cache
-        yield from _local(todo[:1], out, 1, cache_root)
-        yield from _local(todo[1:], out, workers, cache_root)
-    else:
-        yield from _local(todo, out, workers, cache_root)
+    # one warm worker: the first item alone (the models), the others `workers` at a time
+    yield from run_local(
+        todo,
+        functools.partial(_run_one, str(out), cache_root),
+        workers,
+        _worker_failed,
+        functools.partial(_prepare, cache_root),
+    )
 
 
-def _local(todo: list[SweepItem], out: Path, workers: int, cache_root: str) -> Iterator[ItemResult]:
-    """Run ``todo`` on a pool of ``min(workers, len(todo))`` local processes, the cores shared
-    among them; yield each result as it finishes."""
-    n_pool = min(workers, len(todo))
-    pool = _local_pool(n_pool)
-    # the cores each item may use ($FEGEAR_WORKERS, if set, decides in the item's process)
-    per_item = None if os.environ.get("FEGEAR_WORKERS") else max(1, (os.cpu_count() or 1) // n_pool)
-    try:
-        futures: dict[Future, SweepItem] = {
-            pool.submit(run_item, it, str(out), cache_root, per_item): it for it in todo
-        }
-        for fut in as_completed(futures):
-            it = futures[fut]
-            try:
-                yield fut.result()
-            except Exception as exc:  # noqa: BLE001  (BrokenProcessPool: a worker died)
-                yield ItemResult(it.name, "failed", 0.0, f"worker: {_one_line(exc)}")
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+def _run_one(out: str, cache_root: str, item: SweepItem, processes: int | None) -> ItemResult:
+    """:func:`run_item` as :func:`fegear.sweep.local.run_local` calls it."""
+    return run_item(item, out, cache_root, processes)
+
+
+def _prepare(cache_root: str, item: SweepItem) -> None:
+    """An item's checks before its run (:func:`fegear.pipeline.run.check_case`), kept in the
+    cache at ``cache_root``."""
+    os.environ["FEGEAR_CACHE"] = cache_root
+    check_case(item.case, workers=1)
+
+
+def _worker_failed(item: SweepItem, exc: BaseException) -> ItemResult:
+    return ItemResult(item.name, "failed", 0.0, f"worker: {_one_line(exc)}")
