@@ -8,10 +8,12 @@ where marked, once more on the cache it left (warm):
   read back), with ``--recompute`` (the positions solved again) and with a new installation
   error (``dgamma_deg = 0.01``);
 * ``sweep``: ``fegear sweep cases/face_gear_nominal.toml --grid
-  errors.dgamma_deg=-0.02:0.02:5`` (five shaft-angle errors, one process): its wall time, and
-  the cache size after each item (the growth per variant after the first);
-* ``sweep2``: the same sweep with ``--workers 2`` (the first item alone, then two side by
-  side);
+  errors.dgamma_deg=-0.02:0.02:5`` (five shaft-angle errors; by default the first item alone,
+  the others' checks prepared beside it, then one item per core side by side,
+  :mod:`fegear.sweep.local`): its wall time, and the cache size after each item (the growth per
+  variant after the first);
+* ``sweep1``: the same sweep with ``--workers 1`` (the items one after the other, each on
+  every core);
 * ``dE``, ``dA1``, ``dA2``, ``dgamma``: ``python cases/face_gear_<error>.py`` (three values each
   through the Python API, ``hybrid`` level 0).
 
@@ -49,12 +51,22 @@ SWEEP = FEGEAR + ["sweep", str(NOMINAL), "--grid", "errors.dgamma_deg=-0.02:0.02
 JOBS = {
     "run": (FEGEAR + ["run", str(NOMINAL), "-q", "--out", "{work}/out"], True),
     "sweep": (SWEEP, False),
-    "sweep2": (SWEEP + ["--workers", "2"], False),
+    "sweep1": (SWEEP + ["--workers", "1"], False),
     **{
         e: ([sys.executable, str(ROOT / "cases" / f"face_gear_{e}.py")], True)
         for e in ("dE", "dA1", "dA2", "dgamma")
     },
 }
+
+
+def _machine() -> str:
+    """The CPU the figures were measured on (they scale with it; the ratios much less)."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            names = [ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")]
+    except OSError:
+        names = []
+    return f"{os.cpu_count()} × {names[0] if names else 'unknown CPU'}"
 
 
 def _busy_cpu_s() -> float:
@@ -207,11 +219,13 @@ def main() -> None:
     text = (
         "# Installation-error studies against one cold run\n\n"
         "`python benchmarks/bench_error_study.py` (2 cores; every job from an empty cache, then "
-        "warm on the cache it left; seed face gear, `hybrid` level 0, 25 positions):\n\n"
+        "warm on the cache it left; seed face gear, `hybrid` level 0, 25 positions; "
+        f"{_machine()}):\n\n"
         + table(rows)
         + "\n\n`sweep`: `fegear sweep cases/face_gear_nominal.toml --grid "
-        "errors.dgamma_deg=-0.02:0.02:5` (one process, items one after the other; `sweep2`: "
-        "`--workers 2`, the first item alone, then two side by side); growth per "
+        "errors.dgamma_deg=-0.02:0.02:5` (the default: the first item alone, the others' checks "
+        "prepared beside it, then two side by side in processes forked from the first's; "
+        "`sweep1`: `--workers 1`, the items one after the other); growth per "
         "variant: the cache size after the last item minus after the first, over the items "
         "between. `dE` … `dgamma`: `python cases/face_gear_<error>.py` (three values each). "
         "Load before: the 1-minute load average before the cold / warm run; others' CPU: the CPU "
