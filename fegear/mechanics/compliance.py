@@ -381,11 +381,13 @@ def locate_on_boundary(
     s = (g22 * b1 - g12 * b2) / det
     t = (g11 * b2 - g12 * b1) / det
     bary_min = np.minimum(np.minimum(s, t), 1.0 - s - t)
-    proj = a + s[..., None] * e1 + t[..., None] * e2
-    dist = np.linalg.norm(pts[:, None, :] - proj, axis=-1)
-    inside = bary_min >= -1e-9
-    # Prefer facets containing the projection, nearest first; otherwise the least outside.
-    score = np.where(inside, dist, 1e30 - bary_min)
+    # Prefer facets containing the projection, nearest first; otherwise the least outside. The
+    # distance to the projection is formed for the containing candidates only (one or two of
+    # the k per point): each entry the same numbers as over all k.
+    score = 1e30 - bary_min
+    ii = np.nonzero(bary_min >= -1e-9)
+    proj = a[ii] + s[ii][:, None] * e1[ii] + t[ii][:, None] * e2[ii]
+    score[ii] = np.linalg.norm(pts[ii[0]] - proj, axis=-1)
     best = np.argmin(score, axis=1)
     rows = np.arange(pts.shape[0])
     sb = np.clip(s[rows, best], 0.0, 1.0)
