@@ -381,11 +381,13 @@ def locate_on_boundary(
     s = (g22 * b1 - g12 * b2) / det
     t = (g11 * b2 - g12 * b1) / det
     bary_min = np.minimum(np.minimum(s, t), 1.0 - s - t)
-    proj = a + s[..., None] * e1 + t[..., None] * e2
-    dist = np.linalg.norm(pts[:, None, :] - proj, axis=-1)
-    inside = bary_min >= -1e-9
-    # Prefer facets containing the projection, nearest first; otherwise the least outside.
-    score = np.where(inside, dist, 1e30 - bary_min)
+    # Prefer facets containing the projection, nearest first; otherwise the least outside. The
+    # distance to the projection is formed for the containing candidates only (one or two of
+    # the k per point): each entry the same numbers as over all k.
+    score = 1e30 - bary_min
+    ii = np.nonzero(bary_min >= -1e-9)
+    proj = a[ii] + s[ii][:, None] * e1[ii] + t[ii][:, None] * e2[ii]
+    score[ii] = np.linalg.norm(pts[ii[0]] - proj, axis=-1)
     best = np.argmin(score, axis=1)
     rows = np.arange(pts.shape[0])
     sb = np.clip(s[rows, best], 0.0, 1.0)
@@ -480,24 +482,42 @@ def _shape_operator(
     return P
 
 
+#: :func:`find_tets`: candidates tested first, and the ``b_min`` that settles a point on them.
+_FIRST = 4
+_CLEAR = 1e-6
+
+
 def find_tets(
     mesh: skfem.MeshTet, points: np.ndarray, k: int = 16
 ) -> tuple[np.ndarray, np.ndarray]:
     """Tetrahedron containing each point (-1 if none of the ``k`` nearest by centroid does) and
-    the point's reference coordinates in it. Vectorised barycentric test."""
+    the point's reference coordinates in it. Vectorised barycentric test: the candidate with
+    the largest smallest barycentric coordinate ``b_min`` wins.
+
+    The ``_FIRST`` nearest candidates are tested first: a point whose best ``b_min`` among them
+    exceeds ``_CLEAR`` lies inside that tetrahedron, away from its faces, hence outside every
+    other tetrahedron of the (conforming) mesh (their ``b_min < 0``), and the full test would
+    pick the same one with the same coordinates; the other points take all ``k``."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     tree = _tree(mesh, "tets", lambda: mesh.p[:, mesh.t].mean(axis=1).T)
     kk = min(k, mesh.t.shape[1])
     _, cand = tree.query(pts, k=kk)
     cand = cand.reshape(pts.shape[0], kk)
     p0, Jinv = _tet_affine(mesh)
-    xi = np.einsum("nkij,nkj->nki", Jinv[cand], pts[:, None, :] - p0[cand])  # (npts, kk, 3)
-    bmin = np.minimum(xi.min(axis=-1), 1.0 - xi.sum(axis=-1))
-    best = np.argmax(bmin, axis=1)
+
+    def best_of(rows: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
+        xi = np.einsum("nkij,nkj->nki", Jinv[c], pts[rows, None, :] - p0[c])  # (n, kc, 3)
+        bmin = np.minimum(xi.min(axis=-1), 1.0 - xi.sum(axis=-1))
+        best = np.argmax(bmin, axis=1)
+        at = np.arange(rows.size)
+        return c[at, best], xi[at, best], bmin[at, best]
+
     rows = np.arange(pts.shape[0])
-    ok = bmin[rows, best] >= -1e-9
-    tets = np.where(ok, cand[rows, best], -1)
-    return tets, xi[rows, best]
+    tets, xi, bmin = best_of(rows, cand[:, : min(_FIRST, kk)])
+    again = np.flatnonzero(~(bmin > _CLEAR)) if kk > _FIRST else rows[:0]
+    if again.size:
+        tets[again], xi[again], bmin[again] = best_of(again, cand[again])
+    return np.where(bmin >= -1e-9, tets, -1), xi
 
 
 def locate_inside(mesh: skfem.MeshTet, points: np.ndarray) -> SurfacePoints:

@@ -161,33 +161,41 @@ def line_hit(
     lo, hi = fm.native_box()
     span = hi - lo
     lo, hi = lo - 0.5 * span, hi + 0.5 * span
+    # The lines still iterating, ``act``, and their state (a, b, s, P, N) packed: a line that
+    # stops writes its state back once (the same numbers as updating the full arrays in place).
     act = np.arange(a.size)
+    ac, bc, sc, Pc, Nc = a, b, s, P3, N3
     for _ in range(max_iter):
         if act.size == 0:
             break
-        pa, na, ra, rb = fm.point_jacobian(a[act], b[act])
-        p[act], n[act] = pa, na
-        F = pa - P3[act] - s[act, None] * N3[act]
+        pa, na, ra, rb = fm.point_jacobian(ac, bc)
+        F = pa - Pc - sc[:, None] * Nc
         going = np.linalg.norm(F, axis=-1) >= TOL_MM  # (NaN: stops, and fails the check below)
+        stop = ~going
+        if stop.any():
+            done = act[stop]
+            p[done], n[done] = pa[stop], na[stop]
+            a[done], b[done], s[done] = ac[stop], bc[stop], sc[stop]
         if not going.any():
             act = act[:0]
             break
-        J = np.stack([ra[going], rb[going], -N3[act[going]]], -1)
-        act = act[going]
+        act, Pc, Nc = act[going], Pc[going], Nc[going]
+        J = np.stack([ra[going], rb[going], -Nc], -1)
         # tiny Tikhonov term: a stack with one singular Jacobian must not stop the batch
         dx = np.linalg.solve(J + 1e-13 * np.eye(3), -F[going][..., None])[..., 0]
         dx = _finite(dx)
-        sc = np.maximum(
+        step = np.maximum(
             1.0,
             np.maximum(
                 np.abs(dx[..., 0]) / (0.25 * span[0]), np.abs(dx[..., 1]) / (0.25 * span[1])
             ),
         )
-        a[act] = np.clip(a[act] + dx[..., 0] / sc, lo[0], hi[0])
-        b[act] = np.clip(b[act] + dx[..., 1] / sc, lo[1], hi[1])
-        s[act] = s[act] + dx[..., 2] / sc
+        ac = np.clip(ac[going] + dx[..., 0] / step, lo[0], hi[0])
+        bc = np.clip(bc[going] + dx[..., 1] / step, lo[1], hi[1])
+        sc = sc[going] + dx[..., 2] / step
     if act.size:  # out of iterations: the points of the last update
-        p[act], n[act] = fm.evaluate(a[act], b[act])
+        a[act], b[act], s[act] = ac, bc, sc
+        p[act], n[act] = fm.evaluate(ac, bc)
     res = np.linalg.norm(p - P3 - s[:, None] * N3, axis=-1)
     ok = np.isfinite(res) & (res < 1e3 * TOL_MM)
     return (
