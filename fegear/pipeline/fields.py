@@ -185,6 +185,35 @@ def _vertex_displacements(
     return np.load(entry.path(".npy")), str(record["solver"])
 
 
+def _member_loads(name: str, smodel, place: Array, cycle, n_dofs: int) -> Array:
+    """``F`` ``(n_dofs, n_positions)`` N: the consistent loads ``P f`` of the converged cell
+    forces on member ``name`` at every position (``P`` as in the contact solve,
+    :func:`fegear.ltca.model.member_load_operator`: pinion cells along ``−n1`` at the pinion
+    flank points, gear cells along ``+n1`` at the points moved across the gap). Only the loaded
+    cells (``f ≠ 0``) are located on the flank: a cell without force adds nothing to ``P f``
+    (its products are zeros, and a zero added leaves a sum as it was), and locating the points
+    was most of the time of the loads, on cell grids that are mostly open."""
+    F = np.zeros((n_dofs, len(cycle.positions)))
+    for i, pos in enumerate(cycle.positions):
+        cols, forces, start = [], [], 0
+        for c in pos.cells or ():
+            f = pos.solution.force[start : start + c.n]
+            start += c.n
+            on = f != 0.0
+            if not on.any():
+                continue
+            x, nrm = c.quad_points[on], c.normals[on]
+            if name == "pinion":
+                cols.append(member_load_operator(smodel, place[i], c.k, x, -nrm))
+            else:
+                x = x + c.gap[on, None, None] * nrm[:, None]
+                cols.append(member_load_operator(smodel, place[i], c.j, x, nrm))
+            forces.append(f[on])
+        if cols:
+            F[:, i] = sp.hstack(cols).tocsr() @ np.concatenate(forces)
+    return F
+
+
 def _loaded_points(pos, member: str, placement: Array) -> dict[int, Array]:
     """``{member tooth: (q, 3) mm}``: the centres of the loaded contact cells of a position on
     each tooth of ``member`` (its frame; gear cells moved across their gap onto its flank)."""
@@ -321,19 +350,7 @@ def _members(
                 for i, pp in enumerate(cycle.positions)
             ]
         )
-        F = np.zeros((body.n_dofs, n_pos))
-        for i, pos in enumerate(cycle.positions):
-            if not pos.cells:
-                continue
-            cols = []
-            for c in pos.cells:
-                if name == "pinion":
-                    cols.append(member_load_operator(smodel, place[i], c.k, c.quad_points,
-                                                     -c.normals))  # fmt: skip
-                else:
-                    q = c.quad_points + c.gap[:, None, None] * c.normals[:, None]
-                    cols.append(member_load_operator(smodel, place[i], c.j, q, c.normals))
-            F[:, i] = sp.hstack(cols).tocsr() @ pos.solution.force
+        F = _member_loads(name, smodel, place, cycle, body.n_dofs)
         U = np.zeros((n_pos, n_v, 3))
         full = np.zeros((body.n_dofs, n_pos))
         used = "none"
@@ -357,7 +374,7 @@ def _members(
         s_max, s_min, s_vm = (np.zeros((n_pos, n_v)) for _ in range(3))
         root: list[tuple[Any, ...]] = [() for _ in range(n_pos)]
         equil: list[Any] = [None] * n_pos
-        fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
+        fixed = np.setdiff1d(np.arange(body.n_dofs), body.free) if root_stress else None
         pts = body.mesh.p.T
         for i in loaded if root_stress else ():
             sig = rec(full[:, i])
