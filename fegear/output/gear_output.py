@@ -77,8 +77,6 @@ Files written to the output folder (each one atomically: complete or absent):
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-from contextvars import copy_context
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -159,10 +157,8 @@ def write_gear_outputs(
     a run whose pictures are in the cache (the same run drawn before) has them copied
     (:mod:`fegear.output.picture_cache`).
     A run whose displacement fields are pending (``run.fields_pending``) gets them here
-    (:func:`fegear.pipeline.run.with_fields`, in a thread: its sparse solves free the GIL)
-    while the pictures are drawn (they show no field) and the VTK files without fields are
-    written (:func:`fegear.output.vtk.write_gear_vtk`), and ``result`` is then built from the
-    run with its fields.
+    (:func:`fegear.pipeline.run.with_fields`) while the pictures are drawn (they show no
+    field), and ``result`` is then built from the run with its fields.
     """
 
     out = Path(out)
@@ -174,24 +170,14 @@ def write_gear_outputs(
     if run.cycle is not None:
         keep = picture_params(run, result)
         kept = kept_pictures(out, keep)  # the same run drawn before: its pictures copied
-        drawn = kept is None
-        fork = process_count(workers, 2) > 1 and drawn
+        fork = process_count(workers, 2) > 1 and kept is None
         plots = apart(lambda r=run, res=result: loaded_plots(out, r, res), fork)
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="fegear-fields") as pool:
-            # the fields (their solves free the GIL) while the pictures are drawn and the VTK
-            # files without fields are written; started after the fork (no thread forked)
-            job = pool.submit(copy_context().run, with_fields, run) if pending else None
-            if kept is None and not fork:
-                kept = plots()  # here, while the sectors are solved
-            ready = job.result if job is not None else None
-            vtk_paths = write_gear_vtk(out, run, views, ready)
-            if job is not None:  # the model with the fields
-                run = job.result()
-                result = build_result(run, views.pattern)
-        paths += vtk_paths
+        if pending:  # the fields while the pictures are drawn, then the model with them
+            run = with_fields(run)
+            result = build_result(run, views.pattern)
+        paths += write_gear_vtk(out, run, views)
         if kept is None:
             kept = plots()
-        if drawn:
             keep_pictures(keep, kept)
         paths += kept
         if is_cylindrical(run):

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import base64
 import math
-from collections.abc import Callable
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -188,50 +187,30 @@ def write_pvd(path: Path, entries: list[tuple[float, int, str]], parts: str = ""
     return atomic_write(path, lambda q: q.write_text(text, encoding="utf-8"))
 
 
-def write_gear_vtk(
-    out: Path, run: GearRun, views, fields: Callable[[], GearRun] | None = None
-) -> list[Path]:
+def write_gear_vtk(out: Path, run: GearRun, views) -> list[Path]:
     """Write the VTK series of a loaded run into ``out/vtk`` and ``out/cycle.pvd``; ``views``:
-    its flank views (:class:`fegear.output.gear_output.FlankViews`). Returns the paths (per
-    position: the members, the contact cells, the flank views; then the collection).
-
-    ``fields``: for a run whose displacement fields are being computed meanwhile (in a thread,
-    :func:`fegear.output.gear_output.write_gear_outputs`), returns the run with them; it is
-    called once the files that do not show them are written (the contact cells and the flank
-    views: they are written while the sectors are solved), then the members' files follow."""
+    its flank views (:class:`fegear.output.gear_output.FlankViews`). Returns the paths."""
     vtk = out / "vtk"
-    n_pos = len(run.cycle.positions)
-    # the fidelities with contact cells (a run with pending fields gets its two members)
-    flanks = bool(views.patches) and (bool(run.members) or run.fields_pending)
-    times = [math.degrees(pos.phi1) for pos in run.cycle.positions]
-    cell_files: list[list[tuple[Path, int, str]]] = []
-    for i, pos in enumerate(run.cycle.positions):
-        t, row = times[i], []
-        name = f"contact_cells_{i:03d}.vtu"
-        empty = not pos.cells  # meshio cannot read an empty VTU back: no field data there
-        row.append((_write_vtu(vtk / name, _contact_mesh(pos), None if empty else t), 0, name))
-        if flanks:
-            for k, (member, frame) in enumerate(views.frames.items()):
-                name = f"flank_{member}_{i:03d}.vtp"
-                path = write_flank_vtp(vtk / name, frame, views.patches[i][member], t)
-                row.append((path, 1 + k, name))
-        cell_files.append(row)
-    if fields is not None:
-        run = fields()
+    paths, entries = [], []
     names = [mf.name for mf in run.members] + ["contact cells"]
+    flanks = bool(views.patches) and bool(run.members)  # the fidelities with contact cells
     if flanks:
         names += [f"{m} flank view" for m in views.frames]
-    paths, entries = [], []
-    n_m = len(run.members)
-    for i in range(n_pos):
-        t, pos = times[i], run.cycle.positions[i]
+    for i, pos in enumerate(run.cycle.positions):
+        t = math.degrees(pos.phi1)
         for part, mf in enumerate(run.members):
             name = f"{mf.name}_{i:03d}.vtu"
             paths.append(_write_vtu(vtk / name, _member_mesh(mf, i, pos), t))
             entries.append((t, part, f"vtk/{name}"))
-        for path, part, name in cell_files[i]:
-            paths.append(path)
-            entries.append((t, n_m + part, f"vtk/{name}"))
+        name = f"contact_cells_{i:03d}.vtu"
+        empty = not pos.cells  # meshio cannot read an empty VTU back: no field data there
+        paths.append(_write_vtu(vtk / name, _contact_mesh(pos), None if empty else t))
+        entries.append((t, len(run.members), f"vtk/{name}"))
+        if flanks:
+            for k, (member, frame) in enumerate(views.frames.items()):
+                name = f"flank_{member}_{i:03d}.vtp"
+                paths.append(write_flank_vtp(vtk / name, frame, views.patches[i][member], t))
+                entries.append((t, len(run.members) + 1 + k, f"vtk/{name}"))
     parts = "parts: " + ", ".join(f"{k} {n}" for k, n in enumerate(names))
     paths.append(write_pvd(out / "cycle.pvd", entries, parts))
     return paths
