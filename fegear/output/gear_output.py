@@ -153,7 +153,9 @@ def write_gear_outputs(
     its result model (:func:`fegear.results.build_result`, with the views' pattern), built if
     not given. ``workers``: the processes the run may use (None: as the positions,
     ``$FEGEAR_WORKERS``, else one per core); with two or more, the pictures of a loaded run
-    are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`);
+    are drawn in a second process while the VTK files are written (:func:`fegear.forked.apart`),
+    except while the fields of a run without root stress are to come (their two solves already
+    use two cores);
     a run whose pictures are in the cache (the same run drawn before) has them copied
     (:mod:`fegear.output.picture_cache`).
     A run whose displacement fields are pending (``run.fields_pending``) gets them here
@@ -170,7 +172,13 @@ def write_gear_outputs(
     if run.cycle is not None:
         keep = picture_params(run, result)
         kept = kept_pictures(out, keep)  # the same run drawn before: its pictures copied
-        fork = process_count(workers, 2) > 1 and kept is None
+        # A second process for the pictures, unless the fields to come are the vertex
+        # displacements only: their two members' solves run side by side on two threads
+        # (fegear.pipeline.fields.displacements), and a forked process then cost more than it
+        # gained (seed face gear, warm: write stage 1.45 s wall and 1.8 s CPU drawn here, 1.54 s
+        # and 2.6 s forked; the fork's copy-on-write pages nearly double the drawing's CPU).
+        solves_side_by_side = pending and not run.case.root_stress
+        fork = process_count(workers, 2) > 1 and kept is None and not solves_side_by_side
         plots = apart(lambda r=run, res=result: loaded_plots(out, r, res), fork)
         if pending:  # the fields while the pictures are drawn, then the model with them
             run = with_fields(run)
