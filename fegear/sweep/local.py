@@ -3,8 +3,8 @@
 An installation-error study runs the same gears many times: every item needs the sector meshes,
 the compliance operators and the factorisations of the displacement fields, and they are the
 same for every item (they depend on the members, the mesh level and the material, not on where
-the mate sits). So all items run in ONE worker process (a fresh interpreter, started with
-``spawn``), which keeps them in memory after the first item:
+the mate sits). So all items run in ONE worker process (forked from the calling one, or a fresh
+interpreter where it cannot fork), which keeps them in memory after the first item:
 
 1. the first item alone, with every core (:func:`_first`): it builds (or reads from the cache)
    the meshes and operators. Meanwhile a forked, low-priority process prepares the later items:
@@ -123,10 +123,16 @@ def _side_by_side(run_one: RunOne, items: Sequence) -> list:
 
 
 def _pool() -> ProcessPoolExecutor:
-    # "spawn": a fresh interpreter (no fork of a process holding BLAS or Dask threads)
+    """The worker: forked from this process where it can fork (it starts with fegear and
+    matplotlib imported, imported here first: a second against starting an interpreter and
+    importing them again, measured on 2 cores), else a fresh ``spawn`` interpreter. A process
+    with Dask's threads never gets here (a sweep on a scheduler has no local worker)."""
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    if method == "fork":
+        pyplot()  # the sweep's own pictures need it too
     return ProcessPoolExecutor(
         max_workers=1,
-        mp_context=multiprocessing.get_context("spawn"),
+        mp_context=multiprocessing.get_context(method),
         initializer=_worker_init,
     )
 

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from fegear import __version__
+from fegear.output.figure import pyplot, save_png
 from fegear.results.model import GearRunResult
 from fegear.results.summary import result_from_summary
 from fegear.store.files import atomic_write, write_json
@@ -366,11 +367,7 @@ def flat_limits(curves: Sequence[np.ndarray]) -> tuple[float, float] | None:
 
 
 def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal: str | None):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     ready = [it for it in items if it.name in docs]
     loaded = any(docs[it.name]["cycle"].get("te_pp_loaded_arcsec") is not None for it in ready)
     fig, axes = plt.subplots(1, 2 if loaded else 1, figsize=(12 if loaded else 6.5, 4.4),
@@ -416,10 +413,7 @@ def _plot_overlay(path: Path, items: Sequence, docs: Mapping[str, dict], nominal
         ax.legend(fontsize=7, ncol=1 if len(ready) <= 8 else 2, loc="best")
     base = sorted({it.base for it in ready})
     fig.suptitle(f"sweep of {', '.join(base)}: {len(ready)} items", fontsize=10)
-    fig.tight_layout()
-    p = atomic_write(path, lambda q: fig.savefig(q, format="png", dpi=110))
-    plt.close(fig)
-    return p
+    return save_png(fig, path)  # one draw, as the runs' pictures
 
 
 def write_sweep_outputs(
