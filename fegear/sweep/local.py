@@ -78,7 +78,7 @@ def _prepare_all(prepare: Prepare, items: Sequence, parent: int) -> None:
     prepare is left to its run (which reports why)."""
     die_with_parent(parent)
     try:
-        os.nice(15)
+        os.nice(19)  # the lowest: only what the first item leaves
     except OSError:
         pass
     for it in items:
