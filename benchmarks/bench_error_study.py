@@ -15,7 +15,8 @@ where marked, once more on the cache it left (warm):
 * ``sweep1``: the same sweep with ``--workers 1`` (the items one after the other, each on
   every core);
 * ``dE``, ``dA1``, ``dA2``, ``dgamma``: ``python cases/face_gear_<error>.py`` (three values each
-  through the Python API, ``hybrid`` level 0).
+  through the Python API, ``hybrid`` level 0);
+* ``level1``: the main job's case at mesh level 1 (``--level 1``), cold and warm.
 
 For each: wall time, the child's peak memory, the cache size at the end, the 1-minute load
 average before it and ``others_cpu_s``, the CPU seconds the rest of the machine used meanwhile
@@ -56,6 +57,7 @@ JOBS = {
         e: ([sys.executable, str(ROOT / "cases" / f"face_gear_{e}.py")], True)
         for e in ("dE", "dA1", "dA2", "dgamma")
     },
+    "level1": (FEGEAR + ["run", str(NOMINAL), "--level", "1", "-q", "--out", "{work}/out"], True),
 }
 
 
@@ -108,8 +110,8 @@ def _one(argv: list[str], work: Path, cache: Path, watch_sweep: bool) -> dict:
     busy, mine = _busy_cpu_s(), _children_cpu_s()
     growth: list[dict] = []
     t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, cwd=work, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    logs = tempfile.TemporaryFile("w+"), tempfile.TemporaryFile("w+")
+    proc = subprocess.Popen(argv, cwd=work, env=env, stdout=logs[0], stderr=logs[1], text=True)
     stop = threading.Event()
 
     def watch() -> None:  # the cache size as each sweep item finishes
@@ -124,13 +126,18 @@ def _one(argv: list[str], work: Path, cache: Path, watch_sweep: bool) -> dict:
     th = threading.Thread(target=watch, daemon=True)
     if watch_sweep:
         th.start()
-    out, err = proc.communicate()
+    # wait4: this job's own peak memory (RUSAGE_CHILDREN's is the largest of all jobs so far)
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
     seconds = time.perf_counter() - t0
+    for fh in logs:
+        fh.seek(0)
+    out, err = (fh.read() for fh in logs)
     stop.set()
     if watch_sweep:
         th.join()
     others = (_busy_cpu_s() - busy) - (_children_cpu_s() - mine)
-    rss = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
+    rss = usage.ru_maxrss / 1024.0
     row = {
         "argv": " ".join(Path(a).name if a.startswith(str(ROOT)) else a for a in argv),
         "exit": proc.returncode,
@@ -227,7 +234,8 @@ def main() -> None:
         "prepared beside it, then two side by side in processes forked from the first's; "
         "`sweep1`: `--workers 1`, the items one after the other); growth per "
         "variant: the cache size after the last item minus after the first, over the items "
-        "between. `dE` … `dgamma`: `python cases/face_gear_<error>.py` (three values each). "
+        "between. `dE` … `dgamma`: `python cases/face_gear_<error>.py` (three values each); "
+        "`level1`: the main job at `--level 1`. "
         "Load before: the 1-minute load average before the cold / warm run; others' CPU: the CPU "
         "seconds the rest of the machine used during it (~0 on an idle machine).\n"
     )
