@@ -482,3 +482,19 @@ def test_a_prepared_item_reads_its_checks_from_the_cache(fzg3):
     for kind in ("contact_path", "handover"):
         assert run.cache.hits.get(kind) == checks[kind] and kind not in run.cache.built
     assert run.cache.hits.get("tca", 0) >= checks["tca"], run.cache
+
+
+def test_items_side_by_side_mesh_their_own_members(fzg3, tmp_path, monkeypatch):
+    """A grid over the module: every item has members of its own, meshed in the process forked
+    for it (the worker never starts gmsh: a process forked after gmsh started cannot mesh,
+    fegear.mesh.gmsh_session.started_here); every item finishes, each built its two meshes."""
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "sw"
+    grid = "pair.module_mm=4.5,4.6,4.7"
+    assert main(["sweep", str(fzg3), "--grid", grid, "--out", str(out), "--workers", "2",
+                 "-q"]) == 0  # fmt: skip
+    names = [it.name for it in build_items([str(fzg3)], [grid])]
+    _check_items(out, names)
+    for n in names:
+        built = json.loads((out / n / "summary.json").read_text())["cache"]["built"]
+        assert built.get("mesh") == 2, (n, built)

@@ -181,17 +181,22 @@ def _sector_meshes_apart(members, sides, n_teeth: int, level: int, workers: int 
     on one thread (deterministic meshes). The mesh made in the other process is the one made
     here (same code and inputs, the cache entry it writes is read back the same); its cache
     lookups are counted as this run's (:func:`fegear.store.cache.recorded`). A process that
-    has run gmsh before meshes both here (:func:`fegear.mesh.gmsh_session.started_here`)."""
+    has run gmsh before meshes both here (:func:`fegear.mesh.gmsh_session.started_here`); one
+    told to keep gmsh out (:func:`fegear.mesh.gmsh_session.mesh_elsewhere`) meshes both in
+    forked processes."""
 
     def one(i: int):
         return recorded(lambda: sector_mesh(members[i], n_teeth, level, side=sides[i]))
 
-    # a process that has run gmsh cannot mesh in a fork of itself (gmsh_session.started_here)
-    fork = process_count(workers, 2) > 1 and not gmsh_session.started_here()
+    # a process that has run gmsh cannot mesh in a fork of itself (gmsh_session.started_here);
+    # one that is to fork meshing processes later meshes in forks too (meshes_elsewhere)
+    both = gmsh_session.meshes_elsewhere()
+    fork = both or (process_count(workers, 2) > 1 and not gmsh_session.started_here())
+    first = apart(lambda: one(0), True) if both else None
     later = apart(lambda: one(1), fork)
 
     def get(i: int):
-        sm, lookups = one(0) if i == 0 else later()
+        sm, lookups = (first() if first else one(0)) if i == 0 else later()
         count_lookups(lookups)
         return sm
 

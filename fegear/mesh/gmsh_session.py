@@ -25,7 +25,13 @@ import tempfile
 import threading
 from collections.abc import Iterator
 
-__all__ = ["initialize", "native_output_to_log", "started_here"]
+__all__ = [
+    "initialize",
+    "mesh_elsewhere",
+    "meshes_elsewhere",
+    "native_output_to_log",
+    "started_here",
+]
 
 #: Whether gmsh was started in this process or in the process it was forked from (a fork
 #: copies the flag with the rest of the memory; see :func:`started_here`).
@@ -42,6 +48,24 @@ def started_here() -> bool:
     ``pthread_cond_wait``, no CPU used). Work that meshes in a forked process
     (:func:`fegear.ltca.analysis.build_models`) meshes here instead when this is true."""
     return _STARTED[0]
+
+
+#: Whether work that meshes should do it in forked processes (:func:`mesh_elsewhere`).
+_ELSEWHERE = [False]
+
+
+def mesh_elsewhere() -> None:
+    """From now on, work in this process that meshes a gear sector does it in a forked process
+    where it can (:func:`fegear.ltca.analysis.build_models`), so that this process never starts
+    gmsh and the processes forked from it later can still mesh (a sweep's worker, whose items
+    run in forks of it: :mod:`fegear.sweep.local`)."""
+    _ELSEWHERE[0] = True
+
+
+def meshes_elsewhere() -> bool:
+    """Whether :func:`mesh_elsewhere` was called in this process (or the one it was forked
+    from) and gmsh was not started here: then sector meshes are made in forked processes."""
+    return _ELSEWHERE[0] and not _STARTED[0]
 
 
 def initialize() -> None:

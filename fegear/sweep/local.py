@@ -38,6 +38,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from typing import TypeVar
 
 from fegear.forked import die_with_parent, fork_map, process_count
+from fegear.mesh.gmsh_session import mesh_elsewhere, started_here
 from fegear.output.figure import pyplot
 
 __all__ = ["run_local"]
@@ -71,6 +72,9 @@ def _worker_init() -> None:  # pragma: no cover  (runs in the worker process)
         except Exception:  # noqa: BLE001  (best effort)
             pass
     pyplot()
+    # the items run in forks of this process: it must not start gmsh (a process forked after
+    # gmsh started cannot mesh: fegear.mesh.gmsh_session.started_here)
+    mesh_elsewhere()
 
 
 def _prepare_all(prepare: Prepare, items: Sequence, parent: int) -> None:
@@ -119,15 +123,20 @@ def _side_by_side(run_one: RunOne, items: Sequence) -> list:
     """``items`` at the same time, one process each (forked from this one), in order."""
     if len(items) == 1:
         return [run_one(items[0], None)]
+    if started_here():  # gmsh ran here (a root-stress remesh): a fork could not mesh
+        log.info("gmsh was started in the sweep's worker: the items one after the other")
+        return [run_one(it, None) for it in items]
     return fork_map(lambda it: run_one(it, 1), list(items))
 
 
 def _pool() -> ProcessPoolExecutor:
     """The worker: forked from this process where it can fork (it starts with fegear and
     matplotlib imported, imported here first: a second against starting an interpreter and
-    importing them again, measured on 2 cores), else a fresh ``spawn`` interpreter. A process
-    with Dask's threads never gets here (a sweep on a scheduler has no local worker)."""
-    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    importing them again, measured on 2 cores), else a fresh ``spawn`` interpreter: where this
+    process cannot fork, or has started gmsh (a process forked after that cannot mesh). A
+    process with Dask's threads never gets here (a sweep on a scheduler has no local worker)."""
+    can_fork = "fork" in multiprocessing.get_all_start_methods()
+    method = "fork" if can_fork and not started_here() else "spawn"  # gmsh: see started_here
     if method == "fork":
         pyplot()  # the sweep's own pictures need it too
     return ProcessPoolExecutor(
