@@ -19,6 +19,11 @@ interpreter where it cannot fork), which keeps them in memory after the first it
    solves its positions in one process. Two items side by side keep both cores busy through
    the parts of an item that run on one core (the TCA, the VTK files, the pictures); one
    item on both cores leaves one idle there. Measured: ``benchmarks/results/error_study.md``.
+   A process forked after gmsh started in its parent cannot mesh
+   (:func:`fegear.mesh.gmsh_session.started_here`): the worker makes its sector meshes in forked
+   processes (:func:`fegear.mesh.gmsh_session.mesh_elsewhere`), so an item with members of its
+   own meshes them in its own process; where gmsh ran in the worker all the same (the remeshed
+   stress sectors of ``root_stress``), the items run one after the other in it.
 
 With ``workers = 1`` the later items run one after the other in the worker process, each with
 every core for its positions. The items' results do not depend on the grouping (the positions
