@@ -380,20 +380,25 @@ def test_leftovers_of_a_killed_run_are_cleaned(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [".sweep.lock", "done_item"]
 
 
+def _two_worker_sweep(fzg3: Path, tmp_path: Path, monkeypatch, grid: str) -> list[dict]:
+    """``fegear sweep --workers 2`` of ``fzg3`` over ``grid`` from an empty cache; every item
+    complete; their ``cache`` records (hits, built) in item order."""
+    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "sw"
+    assert main(["sweep", str(fzg3), "--grid", grid, "--out", str(out), "--workers", "2",
+                 "-q"]) == 0  # fmt: skip
+    names = [it.name for it in build_items([str(fzg3)], [grid])]
+    _check_items(out, names)
+    return [json.loads((out / n / "summary.json").read_text())["cache"] for n in names]
+
+
 def test_with_two_workers_the_first_item_builds_what_the_others_read(fzg3, tmp_path,
                                                                       monkeypatch):  # fmt: skip
     """``--workers 2`` from an empty cache: the first item runs alone and builds the sector
     meshes and operators; the two after it, side by side, read them (each item's own cache
     records in its summary.json): items started together would each build them."""
-    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
-    out = tmp_path / "sw"
-    grid = "errors.da_mm=0,0.01,0.02"
-    assert main(["sweep", str(fzg3), "--grid", grid, "--out", str(out), "--workers", "2",
-                 "-q"]) == 0  # fmt: skip
-    names = [it.name for it in build_items([str(fzg3)], [grid])]
-    _check_items(out, names)
-    built = [json.loads((out / n / "summary.json").read_text())["cache"]["built"] for n in names]
-    hits = [json.loads((out / n / "summary.json").read_text())["cache"]["hits"] for n in names]
+    uses = _two_worker_sweep(fzg3, tmp_path, monkeypatch, "errors.da_mm=0,0.01,0.02")
+    built, hits = [u["built"] for u in uses], [u["hits"] for u in uses]
     assert "mesh" in built[0] and "compliance" in built[0], built[0]
     for b, h in zip(built[1:], hits[1:], strict=True):
         assert "mesh" not in b and "compliance" not in b, b
@@ -488,13 +493,5 @@ def test_items_side_by_side_mesh_their_own_members(fzg3, tmp_path, monkeypatch):
     """A grid over the module: every item has members of its own, meshed in the process forked
     for it (the worker never starts gmsh: a process forked after gmsh started cannot mesh,
     fegear.mesh.gmsh_session.started_here); every item finishes, each built its two meshes."""
-    monkeypatch.setenv("FEGEAR_CACHE", str(tmp_path / "cache"))
-    out = tmp_path / "sw"
-    grid = "pair.module_mm=4.5,4.6,4.7"
-    assert main(["sweep", str(fzg3), "--grid", grid, "--out", str(out), "--workers", "2",
-                 "-q"]) == 0  # fmt: skip
-    names = [it.name for it in build_items([str(fzg3)], [grid])]
-    _check_items(out, names)
-    for n in names:
-        built = json.loads((out / n / "summary.json").read_text())["cache"]["built"]
-        assert built.get("mesh") == 2, (n, built)
+    for use in _two_worker_sweep(fzg3, tmp_path, monkeypatch, "pair.module_mm=4.5,4.6,4.7"):
+        assert use["built"].get("mesh") == 2, use

@@ -60,9 +60,6 @@ Prepare = Callable[[Item], object]
 #: ``failed(item, exc)``: the result of an item whose worker process died.
 Failed = Callable[[Item, BaseException], Result]
 
-#: The worker's preparation process, if one was started (reaped when the worker ends).
-_PREPARING: list[multiprocessing.process.BaseProcess] = []
-
 
 def _worker_init() -> None:  # pragma: no cover  (runs in the worker process)
     """The worker: ends with the sweep process (Linux), and has matplotlib imported once: every
@@ -110,11 +107,9 @@ def _start_preparing(prepare: Prepare, items: Sequence) -> None:
         daemon=True,  # ends with the worker; it forks nothing (prepare runs on one process)
     )
     try:
-        proc.start()
+        proc.start()  # a daemon: ended with the worker if still running then
     except OSError as exc:  # out of processes or memory: each item does its own checks
         log.info("no preparation process (%s)", exc)
-        return
-    _PREPARING.append(proc)
 
 
 def _first(run_one: RunOne, prepare: Prepare | None, item, later: Sequence) -> list:
