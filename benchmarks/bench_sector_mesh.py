@@ -51,7 +51,7 @@ def members():
     yield "face_gear_pinion", InvoluteMember(
         InvoluteDesign(25, d.module_mm, d.pressure_angle_deg, rack_tip_radius_coeff=0.3,
                        face_width_mm=d.pinion_face_width_mm), "pinion")  # fmt: skip
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
+    from fegear.geometry.bevel import SpiralBevelPair
 
     pair = SpiralBevelPair.design()
     yield "bevel_pinion", pair.pinion

@@ -5,7 +5,7 @@ Run: ``python benchmarks/bench_tca.py``. Times (wall clock, best of 3): the full
 (reference phase + 25 positions × 3 pairs, separation grids 15 × 9, Hertz at 350.14 N·m) and the
 same without separation grids. Spiral bevel (12/36, docs/reference_pairs.md;
 ``SpiralBevelPair.design()`` is not timed): the first run ("cold") includes building the native
-flank tables of both members (:class:`fegear.geometry.spiral_bevel.NativeFlank`), then best of 3
+flank tables of both members (:class:`fegear.geometry.bevel.native.NativeFlank`), then best of 3
 with and without grids.
 """
 
@@ -15,12 +15,12 @@ import logging
 import time
 
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.bevel import SpiralBevelPair
 from fegear.geometry.pair_placement import (
     InstallationErrors,
     face_gear_assembly,
     spiral_bevel_assembly,
 )
-from fegear.geometry.spiral_bevel import SpiralBevelPair
 from fegear.tca import TCAOptions, run_tca
 
 log = logging.getLogger("bench_tca")

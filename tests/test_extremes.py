@@ -148,12 +148,16 @@ def test_bevel_tooth_check_names_the_field():
     from types import SimpleNamespace
 
     from fegear.errors import DesignError
-    from fegear.geometry.spiral_bevel import SpiralBevelMember
+    from fegear.geometry.bevel import SpiralBevelMember
 
     L = np.linspace(60.0, 90.0, 4)  # toe -> heel
 
     def member(land, sing=(0.2, 0.3)):
-        blank = SimpleNamespace(outer_cone_distance=90.0, face_width_mm=30.0)
+        blank = SimpleNamespace(
+            outer_cone_distance=lambda i: 90.0,
+            face_width=lambda i: 30.0,
+            field_prefix="spiral_bevel",
+        )
         return SimpleNamespace(tooth_limits=lambda: (L, np.array(land), np.array(sing)),
                                blank=blank, name="pinion", index=1, n_teeth=9)  # fmt: skip
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from fegear.errors import DesignError, InputError
-from fegear.geometry.spiral_bevel import (
+from fegear.geometry.bevel import (
     SpiralBevelBlank,
     SpiralBevelPair,
     SynthesisTargets,
@@ -81,7 +81,7 @@ def test_mean_point_spiral_and_pressure_angle(pair):
             assert abs(alpha - b.pressure_angle_deg) < 0.05, f"{m.name} {side}: α = {alpha}"
             assert abs(beta - b.spiral_angle_deg) < 0.05, f"{m.name} {side}: β = {beta}"
             # the mean point is on the pitch cone at the mean cone distance (solver tol 1e-11)
-            assert L == pytest.approx(b.mean_cone_distance, abs=1e-9)
+            assert L == pytest.approx(b.mean_cone_distance(m.index), abs=1e-9)
             assert abs(h) < 1e-9
 
 
@@ -96,8 +96,8 @@ def test_face_width_toe_to_heel(pair):
             rho = np.hypot(fl.points[..., 0], fl.points[..., 1])
             L = fl.points[..., 2] * math.cos(g) + rho * math.sin(g)
             # toe and heel columns lie on the front / back cones (point solve tol 1e-11 mm)
-            assert np.allclose(L[:, 0], b.outer_cone_distance - b.face_width_mm, atol=1e-9)
-            assert np.allclose(L[:, -1], b.outer_cone_distance, atol=1e-9)
+            assert np.allclose(L[:, 0], b.outer_cone_distance(m.index) - b.face_width_mm, atol=1e-9)
+            assert np.allclose(L[:, -1], b.outer_cone_distance(m.index), atol=1e-9)
             span = float(np.max(L[:, -1] - L[:, 0]))
             assert span == pytest.approx(25.4, abs=1e-9), f"{m.name} {side}: span {span}"
 
@@ -391,7 +391,7 @@ def test_point_plane_cuts_the_root_cone_at_the_blank_dedendum(pair):
     b = pair.blank
     for m in members(pair):
         i = m.index
-        bm = b.mean_cone_distance * math.tan(b.dedendum_angles[i - 1])  # mean dedendum
+        bm = b.mean_cone_distance(i) * math.tan(b.dedendum_angles[i - 1])  # mean dedendum
         for side in SIDES:
             e = m.edge_tool(side)
             # the mean point (tool origin) lies the mean dedendum above the root cone; along the

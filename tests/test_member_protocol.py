@@ -59,7 +59,7 @@ def bevel_pair():
     module 25.4/5.14 and are compared to 1e-13. Designed without tuning the third-order roll
     (``symmetric_te=False``: 4 s instead of 20 s), which centres the TE parabola: the blank,
     hence the sector frames and the flank-map limits, and the protocol are the same."""
-    from fegear.geometry.spiral_bevel import SpiralBevelPair, SynthesisTargets
+    from fegear.geometry.bevel import SpiralBevelPair, SynthesisTargets
 
     return SpiralBevelPair.design(targets=SynthesisTargets(symmetric_te=False))
 

@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
+from fegear.geometry.bevel import SpiralBevelPair
 from fegear.geometry.pair_placement import InstallationErrors, spiral_bevel_assembly
-from fegear.geometry.spiral_bevel import SpiralBevelPair
 from fegear.tca import TCAOptions, flank_map, run_tca
 from fegear.tca.bevel import cycle_angles, error_effects, path_angle_on_gear, te_parabola
 

@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from fegear.geometry.spiral_bevel import SpiralBevelPair, transmission_error  # noqa: E402
+from fegear.geometry.bevel import SpiralBevelPair, transmission_error  # noqa: E402
 from fegear.geometry.transforms import apply_points, rot_z  # noqa: E402
 
 HERE = Path(__file__).parent
@@ -85,7 +85,7 @@ def fillet_sections(pair: SpiralBevelPair) -> Path:
     height ``h`` above the pitch cone."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 5.5), dpi=90)
     b = pair.blank
-    A0, F = b.outer_cone_distance, b.face_width_mm
+    A0, F = b.outer_cone_distance(2), b.face_width_mm
     u = np.concatenate([np.linspace(-1.0, 0.0, 25), np.linspace(0.0, 1.0, 41)[1:]])
     for ax, m in zip(axes, (pair.pinion, pair.gear), strict=True):
         g = m.pitch_angle

@@ -95,8 +95,8 @@ def spiral_bevel() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from fegear.geometry.bevel import SpiralBevelPair
     from fegear.geometry.pair_placement import spiral_bevel_assembly
-    from fegear.geometry.spiral_bevel import SpiralBevelPair
     from fegear.tca.bevel import cycle_angles, error_effects, path_angle_on_gear, te_parabola
 
     pair = SpiralBevelPair.design()

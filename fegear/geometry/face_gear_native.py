@@ -9,7 +9,7 @@ coordinates ``(u, v)`` is a 2-D Newton of envelopes (the height ``z(u, L)`` and 
 differences cost two more. A closest-point search (the distance of a meshed or CAD flank to the
 exact one, :func:`fegear.mesh.sector_geometry.flank_distance`) therefore runs in ``(t, u_s)``,
 where the parameters extend past the flank limits onto the generated surface itself (not onto
-the fillet), as they do for the spiral bevel's :class:`~fegear.geometry.spiral_bevel.NativeFlank`.
+the fillet), as they do for the spiral bevel's :class:`~fegear.geometry.bevel.native.NativeFlank`.
 """
 
 from __future__ import annotations

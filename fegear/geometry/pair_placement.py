@@ -18,7 +18,7 @@ Sign conventions (written once; ``docs/conventions.md``, ``docs/tca/assembly_con
 Intersecting axes (face gear, spiral bevel). The axes of the error-free pair intersect at the
 crossing point ``O`` (bevel: the pitch-cone apex; face gear: the point of the face-gear axis at the
 height ``r_p1`` of the pinion axis). Fixed frame: member-2 axis ``+z`` (face gear) or
-``+x`` (bevel mesh frame of :mod:`fegear.geometry.spiral_bevel`), common perpendicular ``y``.
+``+x`` (bevel mesh frame of :mod:`fegear.geometry.bevel.mesh_frame`), common perpendicular ``y``.
 
 - ``ΔE`` (mm): change of the shortest distance between the axes; the pinion is moved by ``ΔE``
   along ``+y`` (the common perpendicular), so the axes become crossed (hypoid-like offset).
@@ -56,7 +56,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from .transforms import compose, inverse, rot_x, rot_y, rot_z, translation
+from .bevel.mesh_frame import gear_frame
+from .transforms import compose, inverse, rot_axis, rot_x, rot_y, rot_z, translation
 
 __all__ = [
     "InstallationErrors",
@@ -68,7 +69,7 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-Kind = Literal["parallel", "intersecting"]
+Kind = Literal["parallel", "intersecting", "crossed"]
 
 
 def tooth_transform(n_teeth: int, k: ArrayLike) -> Array:
@@ -114,7 +115,7 @@ class Assembly:
     Attributes
     ----------
     kind
-        ``"parallel"`` or ``"intersecting"``.
+        ``"parallel"``, ``"intersecting"`` or ``"crossed"`` (a hypoid: offset axes).
     n1, n2
         Tooth numbers (member 1 pinion, driving; member 2 gear, driven).
     side1, side2
@@ -327,33 +328,44 @@ def face_gear_assembly(
 def spiral_bevel_assembly(
     pair, side: str = "drive", errors: InstallationErrors | None = None
 ) -> Assembly:
-    """Spiral bevel pair in the mesh frame of :meth:`SpiralBevelPair.mesh_placement`.
+    """Spiral bevel or hypoid pair in the mesh frame of :mod:`fegear.geometry.bevel.mesh_frame`.
 
-    Apex ``O`` at the origin, pinion axis ``+z``, gear axis ``rot_y(Σ) e_z`` (``+x`` for 90°);
-    at ``φ1 = φ2 = 0`` the mean points of the ``side`` flanks coincide (phase2 = 0 is already the
-    reference). The pinion turns about ``σ e_z``, the gear about ``−σ e_2`` (σ of the synthesis
-    report). Errors: ΔE along ``+y`` (pinion), ΔP along ``+z`` (pinion, away from the apex),
-    ΔG along ``+e_2`` (gear, away from the apex), Δγ: the pinion axis is turned about ``+y``
-    by ``−Δγ`` so that the shaft angle becomes ``Σ + Δγ``.
+    Pinion pitch apex at the origin, pinion axis ``+z``; the gear axis through its pitch apex
+    ``A2`` along ``e2`` (``rot_y(Σ) e_z`` through the origin for intersecting axes); at
+    ``φ1 = φ2 = 0`` the mean points of the ``side`` flanks coincide (phase2 = 0 is already the
+    reference). The pinion turns about ``σ e_z``, the gear about ``−σ e2`` (σ of the synthesis
+    report). Errors, about the crossing point ``O`` of the axes (the point of the pinion axis
+    nearest the gear axis): ΔE along the common perpendicular ``d`` from the gear axis to the
+    pinion axis (``+y`` for intersecting axes), so that the distance of the axes becomes
+    ``E + ΔE``; ΔP along ``+z`` (pinion, away from its apex and ``O``), ΔG along ``+e2`` (gear,
+    away from its apex); Δγ: the pinion axis turned about ``e_z × e2`` through ``O`` by ``−Δγ``
+    so that the shaft angle becomes ``Σ + Δγ``.
     """
     errors = errors or InstallationErrors()
     r = pair.reports[side]
-    S = math.radians(pair.blank.shaft_angle_deg)
+    blank = pair.blank
     sigma = int(round(r.sigma))
+    A2, e2 = blank.gear_axis()
+    O = blank.crossing_point()
+    axis = np.cross([0.0, 0.0, 1.0], e2)
+    d = np.array([0.0, 1.0, 0.0])
+    if blank.offset_mm > 0.0:  # from the gear axis's nearest point to O
+        foot = A2 + e2 * np.dot(O - A2, e2)
+        d = (O - foot) / np.linalg.norm(O - foot)
     base1 = compose(
-        translation([0.0, errors.dE_mm, 0.0]),
-        rot_y(-math.radians(errors.dgamma_deg)),
+        translation(errors.dE_mm * d),
+        _about(O, rot_axis(axis, -math.radians(errors.dgamma_deg))),
         translation([0.0, 0.0, errors.dA1_mm]),
     )
-    base2 = compose(rot_y(S), translation([0.0, 0.0, errors.dA2_mm]))
+    base2 = compose(gear_frame(blank), translation([0.0, 0.0, errors.dA2_mm]))
 
     def nominal() -> Assembly:
         return spiral_bevel_assembly(pair, side, None)
 
     return Assembly(
-        kind="intersecting",
-        n1=pair.blank.n1,
-        n2=pair.blank.n2,
+        kind="intersecting" if blank.offset_mm == 0.0 else "crossed",
+        n1=blank.n1,
+        n2=blank.n2,
         side1=side,
         side2=side,
         base1=base1,
@@ -363,7 +375,7 @@ def spiral_bevel_assembly(
         phase1=0.0,
         phase2=0.0,
         const1=rot_z(-r.pinion_flank_angle),
-        const2=rot_z(math.pi - r.gear_flank_angle),
+        const2=rot_z(-r.gear_flank_angle),
         errors=errors,
         nominal=nominal,
     )

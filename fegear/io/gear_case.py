@@ -25,11 +25,11 @@ from pathlib import Path
 from typing import Any
 
 from fegear.errors import InputError
+from fegear.geometry.bevel import SpiralBevelBlank, SynthesisTargets
 from fegear.geometry.cylindrical import RELIEF_SHAPES
 from fegear.geometry.face_gear import FaceGearDesign
 from fegear.geometry.involute import InvoluteDesign
 from fegear.geometry.pair_placement import InstallationErrors
-from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
 from fegear.io.schema import (
     BOOLEAN,
     INT_PAIR,

@@ -25,7 +25,7 @@ Construction (gmsh, OpenCASCADE kernel; :mod:`fegear.mesh.sector_geometry` compu
 
 Fillets: every family models the generated fillet (the involute's trochoid from the rack tip,
 the face gear's trace of the shaper's tip edge, :mod:`fegear.geometry.face_gear_fillet`, the
-spiral bevel's envelope of the blade's edge radius, :mod:`fegear.geometry.spiral_bevel`) and the
+spiral bevel's envelope of the blade's edge radius, :mod:`fegear.geometry.bevel`) and the
 root between the fillets of a tooth space. Each section carries them as one edge per space half
 (space middle → root → fillet → fillet limit) through 25 exact points at about equal arc lengths
 (:func:`~.sector_geometry._root_fillet`), so that the loft stays regular where the face-gear

@@ -18,6 +18,7 @@ from typing import Any, Protocol
 
 from fegear.errors import DesignError, InputError
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
+from fegear.geometry.bevel import SpiralBevelBlank, SpiralBevelPair, SynthesisTargets
 from fegear.geometry.cylindrical import CylindricalMember, FlankModifications, signed_helix_deg
 from fegear.geometry.design_checks import validate_involute_pair
 from fegear.geometry.pair_placement import (
@@ -27,8 +28,6 @@ from fegear.geometry.pair_placement import (
     involute_assembly,
     spiral_bevel_assembly,
 )
-from fegear.geometry.spiral_bevel import SpiralBevelPair
-from fegear.geometry.spiral_bevel_settings import SpiralBevelBlank, SynthesisTargets
 from fegear.io.gear_case import PAIR_SECTIONS, GearCase
 from fegear.store.cache import cached_file
 
@@ -46,7 +45,7 @@ class GearPair:
     assembly
         Their :class:`~fegear.geometry.pair_placement.Assembly` with the case's installation errors.
     spiral_bevel
-        The synthesized :class:`~fegear.geometry.spiral_bevel.SpiralBevelPair` (spiral bevel
+        The synthesized :class:`~fegear.geometry.bevel.SpiralBevelPair` (spiral bevel
         cases only, else None): what re-assembling with other errors needs.
     """
 
@@ -327,7 +326,7 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
     """The synthesized spiral bevel pair of the blank data: read from the artefact cache when
     the same blank and targets were synthesized before by the same geometry code (the synthesis
     takes 10-20 s), else synthesized and cached. The entry is the pair's plain-data record
-    (:meth:`~fegear.geometry.spiral_bevel.SpiralBevelPair.record`, JSON: no pickle); the key
+    (:meth:`~fegear.geometry.bevel.SpiralBevelPair.record`, JSON: no pickle); the key
     holds the code version of ``fegear.geometry`` and the numpy and scipy versions
     (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis invalidates it."""
     box: dict[str, Any] = {}

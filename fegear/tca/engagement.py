@@ -94,9 +94,10 @@ class _Body:
             self.face = (float(d.inner_radius_mm), float(d.outer_radius_mm))
         elif hasattr(member, "blank") and hasattr(member, "pitch_angle"):  # spiral bevel
             b = member.blank
-            a0 = float(b.outer_cone_distance)
+            i = member.index
+            a0 = float(b.outer_cone_distance(i))
             self.kind = "bevel"
-            self.face = (a0 - float(b.face_width_mm), a0)
+            self.face = (a0 - float(b.face_width(i)), a0)
         elif hasattr(member, "r_a") and hasattr(member, "r_f"):  # involute (spur / helical)
             w = float(member.design.face_width_mm)
             self.kind = "involute"
@@ -132,8 +133,7 @@ class _Body:
             b = self.m.blank
             L = z * math.cos(g) + rho * math.sin(g)
             h = rho * math.cos(g) - z * math.sin(g)
-            dedendum = b.dedenda[self.m.index - 1]
-            d, s = -dedendum * L / float(b.outer_cone_distance) - h, L  # root cone through apex
+            d, s = b.root_height(self.m.index, L) - h, L  # below the root cone
         return np.where((s >= lo) & (s <= hi), d, -np.inf)
 
 

@@ -17,7 +17,7 @@ coordinates* ``(u, v)`` (profile × face, with :class:`~fegear.geometry.surface.
   tangents, native = flank coordinates ``(u, z)``; it is the member's own working flank.
 - :class:`SpiralBevelMap`: face-milled spiral bevel, native ``(s, θ)`` cutter parameters, ψ from
   the equation of meshing by Newton from a tabulated predictor
-  (:class:`~fegear.geometry.spiral_bevel.NativeFlank`); analytic Jacobian; flank coordinates:
+  (:class:`~fegear.geometry.bevel.native.NativeFlank`); analytic Jacobian; flank coordinates:
   the fraction of the working height above the fillet-limit curve, and the cone distance.
 - :class:`FaceGearMap`: face gear with γ = 90°: Litvin's closed form (Litvin & Fuentes 2004
   §19.3; :func:`fegear.geometry.face_gear.closed_form_point`), native ``(t, ψ)`` = shaper roll and
@@ -340,7 +340,7 @@ class FaceGearMap(FlankMap):
 class SpiralBevelMap(FlankMap):
     """Face-milled spiral bevel member; native ``(s, θ)`` = blade parameter and cutter angle.
 
-    Evaluation by :class:`~fegear.geometry.spiral_bevel.NativeFlank`: the exact envelope, ψ from
+    Evaluation by :class:`~fegear.geometry.bevel.native.NativeFlank`: the exact envelope, ψ from
     the equation of meshing by Newton from a tabulated predictor (agrees with the engine's
     ``point_normal`` to ~1e-13 mm, tested). The Jacobian is analytic (implicit-function theorem),
     not a finite difference. Flank coordinates ``(u, v)``: the fraction of the working height

@@ -22,7 +22,7 @@ infinitely long contact) has the same peak in every section; an uncrowned line c
 pressure rises towards the face ends, which it does not model. At ``hertz`` fidelity (no cells)
 it is the pair's closed-form Hertz pressure.
 
-*Spiral bevel.* The synthesis (:mod:`fegear.geometry.spiral_bevel_settings`) designs the unloaded
+*Spiral bevel.* The synthesis (:mod:`fegear.geometry.bevel.synthesis`) designs the unloaded
 TE as the parabola :math:`\Delta\varphi_2 = -\Delta (N_1/\pi)^2 \varphi_1^2` of amplitude
 :math:`\Delta` (``te_amplitude_arcsec``) over the cycle :math:`\varphi_1 \in [-\pi/N_1, \pi/N_1]`.
 The rigid TCA's TE over the cycle gives the peak-to-peak, and a least-squares parabola through it
