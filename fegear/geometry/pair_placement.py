@@ -342,7 +342,7 @@ def spiral_bevel_assembly(
     so that the shaft angle becomes ``Σ + Δγ``.
     """
     errors = errors or InstallationErrors()
-    r = pair.reports[side]
+    r = pair.placements[side]
     blank = pair.blank
     sigma = int(round(r.sigma))
     A2, e2 = blank.gear_axis()

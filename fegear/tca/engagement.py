@@ -130,10 +130,9 @@ class _Body:
             d, s = float(self.m.root_height) - z, rho
         else:
             g = float(self.m.pitch_angle)
-            b = self.m.blank
             L = z * math.cos(g) + rho * math.sin(g)
             h = rho * math.cos(g) - z * math.sin(g)
-            d, s = b.root_height(self.m.index, L) - h, L  # below the root cone
+            d, s = self.m.root_cone_height(L) - h, L  # below the root cone
         return np.where((s >= lo) & (s <= hi), d, -np.inf)
 
 

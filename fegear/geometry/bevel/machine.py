@@ -96,6 +96,13 @@ class MachineSettings:
         fixed by the local synthesis (it enters the pinion curvature at the mean point); D
         (third order, no effect on the curvature at M) is tuned so the TE parabola is symmetric
         over the cycle (:meth:`~fegear.geometry.bevel.pair.SpiralBevelPair.design`).
+    point_plane_mm
+        ``z_t`` (tool frame) of the cutter's point plane, the plane of the blade tips that the
+        edge radius touches. None (synthesized settings): where the machine plane touches the
+        blank's root cone at the mean cone distance (:func:`point_plane`). A number (settings
+        as a summary sheet gives them: the blade tips in the cradle plane, ``−ref_height_mm``):
+        the settings decide the tooth depth, and the member's root cone is the one the point
+        plane sweeps (:meth:`~fegear.geometry.bevel.member.SpiralBevelMember.root_cone_line`).
     """
 
     member: str
@@ -118,6 +125,7 @@ class MachineSettings:
     ratio_of_roll: float
     modified_roll: float
     modified_roll_third: float = 0.0
+    point_plane_mm: float | None = None
 
     def __post_init__(self) -> None:
         if self.blade not in ("outside", "inside"):

@@ -54,7 +54,7 @@ from ..generation import Envelope, generate
 from ..surface import BlankOutline, ConeLine, FlankBoundaries, FlankCoordinates, FlankSurface, Side
 from .blank import SpiralBevelBlank
 from .cutter import EdgeRadius, blade_tip
-from .machine import MachineSettings, head_cutter, machine_motion, point_plane
+from .machine import MachineSettings, blank_placement, head_cutter, machine_motion, point_plane
 from .native import NativeFillet, NativeFlank, cone_coords
 
 __all__ = ["FlankEvaluation", "FilletLimit", "SpiralBevelMember"]
@@ -178,9 +178,56 @@ class SpiralBevelMember:
         if key not in self._cache:
             ms = self.settings(side)
             cutter = self._tools(side)[0]
-            zp = point_plane(self.blank, self.index, ms)
+            zp = ms.point_plane_mm
+            if zp is None:
+                zp = point_plane(self.blank, self.index, ms)
             self._cache[key] = blade_tip(cutter, ms.edge_radius_mm, zp)
         return self._cache[key]
+
+    def root_cone_line(self) -> tuple[float, float]:
+        """``(a, b)`` of the member's root cone ``h_R(L) = a + b L`` in its ``(L, h)`` plane.
+
+        The blank's (:meth:`~.blank.SpiralBevelBlank.root_cone_line`) where the settings put
+        the point plane on it (synthesized settings), else the cone the cutters' point plane
+        sweeps: at ψ = 0 the plane ``z_m = z_p`` of the machine is ``n·X = c`` in the member
+        frame (``n`` the third row of the blank placement's rotation); turned about the member
+        axis its envelope in the axial half-plane is the line ``n_ρ ρ + n_z z = c``,
+        ``n_ρ = |(n_x, n_y)|`` (the side :func:`~.machine.point_plane` touches), i.e. in
+        ``(L, h)``: ``a = c / (n_ρ cos γ − n_z sin γ)``,
+        ``b = −(n_ρ sin γ + n_z cos γ) / (n_ρ cos γ − n_z sin γ)``.
+
+        Raises :class:`~fegear.errors.DesignError` if the two sides' settings sweep root cones
+        more than 1 µm apart over the face (one root cone per member is modelled).
+        """
+        key = "root_cone"
+        if key not in self._cache:
+            ms = {side: self.settings(side) for side in ("drive", "coast")}
+            if all(m.point_plane_mm is None for m in ms.values()):
+                self._cache[key] = self.blank.root_cone_line(self.index)
+            else:
+                lines = {side: _swept_root(m, self.pitch_angle) for side, m in ms.items()}
+                A0, F = (
+                    self.blank.outer_cone_distance(self.index),
+                    self.blank.face_width(self.index),
+                )
+                L = np.array([A0 - F, A0])
+                (a1, b1), (a2, b2) = lines["drive"], lines["coast"]
+                gap = float(np.max(np.abs((a1 + b1 * L) - (a2 + b2 * L))))
+                if gap > 1e-3:
+                    raise DesignError(
+                        f"machine.{self.name}_coast.machine_root_angle",
+                        ms["coast"].machine_root_angle_deg,
+                        f"the root cone of machine.{self.name}_drive",
+                        f"the two sides of the {self.name} cut root cones {gap:.4f} mm apart "
+                        "(one root cone per member is modelled)",
+                    )  # fmt: skip
+                self._cache[key] = lines["drive"]
+        return self._cache[key]
+
+    def root_cone_height(self, L: ArrayLike) -> Array:
+        """Height ``h_R(L)`` (mm) of the member's root cone (:meth:`root_cone_line`)."""
+        a, b = self.root_cone_line()
+        return a + b * np.asarray(L, float)
 
     def _theta_solve(
         self, side: Side, tool, w: Array, L: Array, theta0: Array, psi0: Array,
@@ -207,13 +254,63 @@ class SpiralBevelMember:
             f"{type(tool).__name__} (max |dL| = {err:.2e} mm)"
         )
 
+    def reference(self, side: Side) -> tuple[float, float, float]:
+        """Cutter parameters ``(s, θ, ψ)`` that generate the mean point of the ``side`` flank
+        (cone distance ``Rm``, on the pitch cone ``h = 0``): the start of every solve.
+
+        Synthesized settings are fitted through the mean point, so it is ``(0, 0, 0)`` (taken
+        as it is when that point is within 1e-9 mm of the mean point). Other settings (a summary
+        sheet's): the nearest generated point over a grid of blade heights, cutter angles and
+        cradle angles, then Newton on ``(L, h)`` (:meth:`_newton`). Cached.
+
+        Raises :class:`~fegear.errors.DesignError` naming the flank's settings when no point
+        of the generated flank comes within 1e-9 mm of the mean point.
+        """
+        key = ("reference", side)
+        if key not in self._cache:
+            self._cache[key] = self._find_reference(side)
+        return self._cache[key]
+
+    def _find_reference(self, side: Side) -> tuple[float, float, float]:
+        tool, mot = self._tools(side)
+        g, rm = self.pitch_angle, self.blank.mean_cone_distance(self.index)
+        e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        L0, h0, _, _ = cone_coords(e0.points, g)
+        if bool(e0.residual < 1e-9) and math.hypot(L0 - rm, h0) < 1e-9:
+            return 0.0, 0.0, 0.0
+        depth = self.blank.addendum(self.index) + self.blank.dedendum(self.index)
+        S, T, P = np.meshgrid(
+            np.linspace(-depth, 2.0 * depth, 7), np.linspace(-1.2, 1.2, 49),
+            np.linspace(-1.0, 1.0, 9), indexing="ij",
+        )  # fmt: skip
+        env = generate(tool, mot, S, T, P, half_width=0.125)
+        L, h, _, _ = cone_coords(env.points, g)
+        miss = np.where(env.residual < 1e-9, np.hypot(L - rm, h), np.inf)
+        k = np.unravel_index(int(np.argmin(miss)), miss.shape)
+        who = f"machine.{self.name}_{side}"
+        if not np.isfinite(miss[k]):
+            raise DesignError(who, "these settings", "settings that cut this flank",
+                              "the cutter generates no flank near the blank")  # fmt: skip
+        s0, th0, psi0 = float(S[k]), float(T[k]), float(env.psi[k])
+        try:
+            env, s1, t1 = self._newton(side, np.array(rm), np.array(0.0), s0, th0, psi0)
+        except SolverError as exc:
+            raise DesignError(
+                who, "these settings", "settings that cut this flank through its mean point",
+                f"the generated flank comes no nearer than {miss[k]:.3f} mm to the mean point "
+                f"(L = {rm:.3f} mm on the pitch cone): {exc}",
+            ) from exc  # fmt: skip
+        return float(s1), float(t1), float(env.psi)
+
     def _theta_predictor(self, side: Side, s: Array, L: Array) -> Array:
         """Linear predictor of θ at blade parameter ``s`` and cone distance ``L`` from the mean
-        point (``s = θ = ψ = 0``)."""
+        point (:meth:`reference`)."""
         tool, mot = self._tools(side)
-        e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        s0, t0, p0 = self.reference(side)
+        e0 = generate(tool, mot, s0, t0, p0, half_width=0.3)
         L0, _, gL0, _ = cone_coords(e0.points, self.pitch_angle)
-        return (np.asarray(L, float) - L0 - (gL0 @ e0.r_u) * np.asarray(s, float)) / (gL0 @ e0.r_t)
+        ds = np.asarray(s, float) - s0
+        return t0 + (np.asarray(L, float) - L0 - (gL0 @ e0.r_u) * ds) / (gL0 @ e0.r_t)
 
     def fillet_limit(self, side: Side, L: ArrayLike, tol: float = 1e-12) -> FilletLimit:
         """The exact fillet limit at cone distances ``L`` (mm): the point of the blade
@@ -222,7 +319,8 @@ class SpiralBevelMember:
         L = np.asarray(L, float)
         sb = np.full(L.shape, self.edge_tool(side).s_blade)
         th0 = self._theta_predictor(side, sb, L)
-        env, th = self._theta_solve(side, self._tools(side)[0], sb, L, th0, np.zeros(L.shape), tol)
+        psi0 = np.full(L.shape, self.reference(side)[2])
+        env, th = self._theta_solve(side, self._tools(side)[0], sb, L, th0, psi0, tol)
         h = cone_coords(env.points, self.pitch_angle)[1]
         return FilletLimit(th, env.psi, env.points, env.normals, h)
 
@@ -305,7 +403,7 @@ class SpiralBevelMember:
             if phi["drive"][0] < phi["coast"][0]:
                 plus, minus = minus, plus
             g = self.pitch_angle
-            rho_root = L * math.sin(g) + self.blank.root_height(self.index, L) * math.cos(g)
+            rho_root = L * math.sin(g) + self.root_cone_height(L) * math.cos(g)
             self._cache[key] = (L, (phi[minus] + self.tooth_angle - phi[plus]) * rho_root)
         return self._cache[key]
 
@@ -468,7 +566,7 @@ class SpiralBevelMember:
         gam = self.pitch_angle
         A0 = bl.outer_cone_distance(i)
         F = bl.face_width(i)
-        root = ConeLine(*bl.root_cone_line(i))
+        root = ConeLine(*self.root_cone_line())
         tip = ConeLine(*bl.face_cone_line(i))
         bot = ConeLine(root.a - rim_modules * m, root.b)
         # plus side: the side whose mean point has the larger polar angle (one exact envelope
@@ -494,20 +592,25 @@ class SpiralBevelMember:
 
     def _solve(self, side: Side, u: ArrayLike, v: ArrayLike) -> tuple[Envelope, Array, Array]:
         """Blade envelope at working flank coordinates ``(u >= 0, v)``: 2-D Newton on the
-        cutter parameters ``(s, θ)`` for the target ``(L, h)``."""
-        tool, mot = self._tools(side)
+        cutter parameters ``(s, θ)`` for the target ``(L, h)`` (:meth:`_newton`), from the mean
+        point's parameters (:meth:`reference`)."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
-        L_t = v
-        h_t = self.height(u, v, side)
+        return self._newton(side, v, self.height(u, v, side), *self.reference(side))
+
+    def _newton(
+        self, side: Side, L_t: Array, h_t: Array, s0: float, t0: float, p0: float
+    ) -> tuple[Envelope, Array, Array]:
+        """Blade envelope points at cone coordinates ``(L_t, h_t)``: linear predictor from the
+        envelope at ``(s0, θ0, ψ0)``, then Newton on ``(s, θ)`` with the engine's tangents."""
+        tool, mot = self._tools(side)
         g = self.pitch_angle
-        # linear predictor from the mean point (s = θ = ψ = 0 by construction)
-        e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        e0 = generate(tool, mot, s0, t0, p0, half_width=0.3)
         L0, h0, gL0, gh0 = cone_coords(e0.points, g)
         J0 = np.array([[gL0 @ e0.r_u, gL0 @ e0.r_t], [gh0 @ e0.r_u, gh0 @ e0.r_t]], dtype=float)
         d = np.stack([L_t - L0, h_t - h0], -1)
         x = np.einsum("ij,...j->...i", np.linalg.inv(J0), d)
-        s, th = x[..., 0], x[..., 1]
-        psi = np.zeros_like(s)
+        s, th = s0 + x[..., 0], t0 + x[..., 1]
+        psi = np.full_like(s, p0)
         hw = 0.6
         for _ in range(40):
             env = generate(tool, mot, s, th, psi, half_width=hw)
@@ -591,3 +694,15 @@ class SpiralBevelMember:
             meshing_residual=ev.meshing_residual,
             boundaries=b,
         )
+
+
+def _swept_root(ms: MachineSettings, gamma: float) -> tuple[float, float]:
+    """``(a, b)`` of the cone ``h = a + b L`` that the point plane of ``ms`` sweeps on a member
+    of pitch angle ``gamma`` (:meth:`SpiralBevelMember.root_cone_line`)."""
+    B = blank_placement(ms)
+    n = B[2, :3]
+    c = ms.ref_height_mm + ms.point_plane_mm - B[2, 3]
+    n_rho, n_z = math.hypot(n[0], n[1]), n[2]
+    cg, sg = math.cos(gamma), math.sin(gamma)
+    den = n_rho * cg - n_z * sg
+    return c / den, -(n_rho * sg + n_z * cg) / den

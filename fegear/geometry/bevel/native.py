@@ -197,7 +197,7 @@ class _NativeEnvelope:
         level = glog.level
         glog.setLevel(max(level, logging.ERROR))
         try:
-            env = generate(tool, mot, S, T, 0.0, half_width=0.6)
+            env = generate(tool, mot, S, T, member.reference(side)[2], half_width=0.6)
         finally:
             glog.setLevel(level)
         ok = env.residual < 1e-9

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InputError
+from ..generation import generate
 from ..surface import Side
 from ..transforms import apply_points, apply_vectors
 from .blank import ARCSEC, SpiralBevelBlank
@@ -33,13 +34,35 @@ Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class SpiralBevelPair:
-    """A designed spiral bevel pair: blank, targets, settings, synthesis reports, members.
+class FlankPlacement:
+    """Where the ``side`` flanks of tooth 0 sit in the mesh position ``φ1 = φ2 = 0``.
 
-    Use :meth:`design`; to override settings, ``dataclasses.replace`` a
-    :class:`MachineSettings` of ``pair.settings`` and pass the new
+    Attributes
+    ----------
+    side
+        ``"drive"`` or ``"coast"``.
+    sigma
+        Sense of pinion rotation (+1: about ``+z`` of the mesh frame) for this side to drive.
+    gear_flank_angle, pinion_flank_angle
+        Polar angles (rad) of the mean points of the gear and pinion flanks in their member
+        frames; each member is turned so that its mean point is at the pitch point ``P``.
+    """
+
+    side: str
+    sigma: float
+    gear_flank_angle: float
+    pinion_flank_angle: float
+
+
+@dataclass(frozen=True)
+class SpiralBevelPair:
+    """A bevel pair: blank, targets, settings, synthesis reports, placements, members.
+
+    Use :meth:`design` (settings synthesized from the targets); to override settings,
+    ``dataclasses.replace`` a :class:`MachineSettings` of ``pair.settings`` and pass the new
     :class:`SpiralBevelSettings` to :meth:`design` (the synthesis reports then describe the
-    synthesized, not the overridden, settings).
+    synthesized, not the overridden, settings). Settings from a summary sheet:
+    :meth:`from_settings` (no synthesis: ``reports`` is empty).
     """
 
     blank: SpiralBevelBlank
@@ -48,6 +71,7 @@ class SpiralBevelPair:
     reports: dict[str, SynthesisReport]
     pinion: SpiralBevelMember
     gear: SpiralBevelMember
+    placements: dict[str, FlankPlacement]
 
     @classmethod
     def design(
@@ -80,14 +104,35 @@ class SpiralBevelPair:
         return pair
 
     @classmethod
+    def from_settings(
+        cls, blank: SpiralBevelBlank, settings: SpiralBevelSettings, check: bool = True
+    ) -> SpiralBevelPair:
+        """The pair whose flanks the given machine settings cut (no synthesis): each member's
+        flanks on the blank, the placement of each side found from the flanks' mean points
+        (:func:`flank_placement`); with ``check``, the edge radii and the teeth checked as in
+        :meth:`design`.
+
+        Raises :class:`~fegear.errors.DesignError` naming the flank's settings when they do not
+        cut a flank through the mean point, a fillet that fits, or a tooth that is neither
+        pointed nor undercut.
+        """
+        pinion, gear = _members(blank, settings)
+        placements = {side: flank_placement(blank, pinion, gear, side) for side in SIDES}
+        pair = cls(blank, SynthesisTargets(), settings, {}, pinion, gear, placements)
+        if check:
+            for m in (pair.pinion, pair.gear):
+                m.check_fillets()
+                m.check_tooth()
+        return pair
+
+    @classmethod
     def _build(cls, blank, targets, settings, reports) -> SpiralBevelPair:
-        pinion = SpiralBevelMember(
-            "pinion", 1, blank.n1, blank, settings.pinion_drive, settings.pinion_coast
-        )
-        gear = SpiralBevelMember(
-            "gear", 2, blank.n2, blank, settings.gear_drive, settings.gear_coast
-        )
-        return cls(blank, targets, settings, reports, pinion, gear)
+        pinion, gear = _members(blank, settings)
+        placements = {
+            side: FlankPlacement(side, r.sigma, r.gear_flank_angle, r.pinion_flank_angle)
+            for side, r in reports.items()
+        }
+        return cls(blank, targets, settings, reports, pinion, gear, placements)
 
     def record(self) -> dict[str, Any]:
         """The pair as plain data (JSON-ready: numbers, strings, lists): blank, targets, machine
@@ -103,6 +148,7 @@ class SpiralBevelPair:
                 for k in ("gear_drive", "gear_coast", "pinion_drive", "pinion_coast")
             },
             "reports": {side: _plain_fields(r) for side, r in self.reports.items()},
+            "placements": {side: _plain_fields(r) for side, r in self.placements.items()},
         }
 
     @classmethod
@@ -127,7 +173,11 @@ class SpiralBevelPair:
             )
             for side, r in rec["reports"].items()
         }
-        return cls._build(blank, targets, settings, reports)
+        if reports:
+            return cls._build(blank, targets, settings, reports)
+        pinion, gear = _members(blank, settings)
+        placements = {side: FlankPlacement(**r) for side, r in rec["placements"].items()}
+        return cls(blank, targets, settings, {}, pinion, gear, placements)
 
     def mesh_placement(self, side: Side):
         """``(pinion(φ1), gear(φ2))``: functions of driving-sense angles (rad) → 4×4 member → mesh.
@@ -137,7 +187,7 @@ class SpiralBevelPair:
         Nominal rotation ``φ2 = (N1/N2) φ1``; the TE is ``φ2 − (N1/N2) φ1``
         (``docs/conventions.md``).
         """
-        r = self.reports[side]
+        r = self.placements[side]
         pin, gear, _ = mesh_transforms(
             self.blank, side, r.gear_flank_angle, r.pinion_flank_angle, r.sigma
         )
@@ -145,6 +195,39 @@ class SpiralBevelPair:
 
 
 _RECORD_FORMAT = "fegear.spiral_bevel_pair/1"
+SIDES = ("drive", "coast")
+
+
+def _members(blank, settings: SpiralBevelSettings) -> tuple[SpiralBevelMember, SpiralBevelMember]:
+    pinion = SpiralBevelMember(
+        "pinion", 1, blank.n1, blank, settings.pinion_drive, settings.pinion_coast
+    )
+    gear = SpiralBevelMember("gear", 2, blank.n2, blank, settings.gear_drive, settings.gear_coast)
+    return pinion, gear
+
+
+def flank_placement(
+    blank, pinion: SpiralBevelMember, gear: SpiralBevelMember, side: Side
+) -> FlankPlacement:
+    """The placement of the ``side`` flanks from their generated mean points: the polar angles
+    of both members' mean points (:meth:`~.member.SpiralBevelMember.reference`) and the
+    pinion's sense of rotation from the gear's normal there, ``σ = sign(((P − A2) × n) · e2)``
+    (the pinion pushes the gear along ``−n``; the gear turns with that torque about ``−σ e2``).
+    """
+    ang = []
+    for m in (gear, pinion):
+        tool, mot = m._tools(side)
+        env = generate(tool, mot, *m.reference(side), half_width=0.3)
+        ang.append(float(math.atan2(env.points[1], env.points[0])))
+        if m is gear:
+            n_gear = env.normals
+    th2, d1 = ang
+    _, gear_f, e2 = mesh_transforms(blank, side, th2, d1, 1.0)
+    G = gear_f(0.0)
+    A2 = blank.gear_axis()[0]
+    n = apply_vectors(G, n_gear)
+    sigma = float(np.sign(np.dot(np.cross(blank.pitch_point() - A2, n), e2)))
+    return FlankPlacement(side, sigma, th2, d1)
 
 
 def _plain_fields(obj: Any) -> dict[str, Any]:
