@@ -47,6 +47,8 @@ from fegear import __version__
 from fegear.errors import FegearError, InputError
 from fegear.export.command import add_parser as add_export
 from fegear.export.command import run as export_ccx
+from fegear.export.settings import add_parser as add_settings
+from fegear.export.settings import run as print_settings
 from fegear.forked import process_count
 from fegear.store.cache import cache_info, check_cache_root, clear_cache
 from fegear.store.files import check_writable_folder, journal
@@ -174,6 +176,7 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--png", help="the PNG (default: FOLDER/bearing_pattern_<member>_flank.png)")
     pl.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     add_export(sub)
+    add_settings(sub)
     return p
 
 
@@ -572,7 +575,7 @@ def main(argv: list[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
-        if args.command in ("run", "sweep", "export-ccx"):
+        if args.command in ("run", "sweep", "export-ccx", "settings"):
             check_cache_root()  # an unusable FEGEAR_CACHE is refused before any work
         if args.command == "run":
             return _run(args)
@@ -584,6 +587,8 @@ def main(argv: list[str] | None = None) -> int:
             return _plot(args)
         if args.command == "export-ccx":
             return export_ccx(args)
+        if args.command == "settings":
+            return print_settings(args)
     except InputError as exc:
         print(f"fegear: error: {exc}", file=sys.stderr)
         return 2

@@ -26,10 +26,13 @@ from typing import Any
 
 from fegear.errors import InputError
 from fegear.geometry.bevel import SpiralBevelBlank, SynthesisTargets
+from fegear.geometry.bevel.sheet import FlankTable
 from fegear.geometry.cylindrical import RELIEF_SHAPES
 from fegear.geometry.face_gear import FaceGearDesign
 from fegear.geometry.involute import InvoluteDesign
 from fegear.geometry.pair_placement import InstallationErrors
+from fegear.io.machine_table import parse_machine
+from fegear.io.machine_table import reference_markdown as machine_reference
 from fegear.io.schema import (
     BOOLEAN,
     INT_PAIR,
@@ -65,6 +68,11 @@ __all__ = [
 ]
 
 GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel")
+#: Kinds whose flanks a face-milling machine cuts: their ``[machine]`` section may give the
+#: settings (:mod:`fegear.io.machine_table`).
+BEVEL_KINDS = ("spiral_bevel",)
+#: ``[pair]`` keys of the synthesis of the settings: not used with a ``[machine]`` section.
+SYNTHESIS_KEYS = ("cutter_radius_mm", "te_amplitude_arcsec")
 #: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
 PARALLEL_KINDS = ("spur", "cylindrical")
 #: Fidelities of the gear pairs (``docs/fidelity.md``).
@@ -547,6 +555,7 @@ def reference() -> str:
     for kind, sec in PAIR_SECTIONS.items():
         parts.append(reference_markdown((sec,), f'`kind = "{kind}"`'))
     parts.append(reference_markdown(errors, "Installation errors"))
+    parts.append('### Machine settings\n\n<a id="machine"></a>\n\n' + machine_reference())
     return "\n".join(parts)
 
 
@@ -579,6 +588,9 @@ class GearCase:
         Recorded only (quasi-static model).
     description, source
         Free text and the file the case came from.
+    machine
+        The ``[machine]`` section of a bevel case as written (the flank tables with their
+        units), None where the settings are synthesized; :meth:`flank_tables` in mm/deg.
     """
 
     name: str
@@ -600,6 +612,12 @@ class GearCase:
     speed_rpm: float | None = None
     description: str = ""
     source: str = "<memory>"
+    machine: dict[str, Any] | None = None
+
+    def flank_tables(self) -> dict[str, FlankTable] | None:
+        """The machine settings of the ``[machine]`` section per flank, in mm and degrees
+        (:mod:`fegear.io.machine_table`); None where they are synthesized."""
+        return None if self.machine is None else parse_machine(self.machine)
 
     @property
     def ratio(self) -> float:
@@ -645,6 +663,8 @@ class GearCase:
         }
         if self.contact.given():
             doc["contact"] = self.contact.given()
+        if self.machine is not None:
+            doc["machine"] = copy.deepcopy(self.machine)
         return doc
 
     def replace(self, **changes: Any) -> GearCase:
@@ -777,6 +797,9 @@ class GearCase:
             "contact": {
                 k: list(v) if isinstance(v, tuple) else v for k, v in self.contact.as_dict().items()
             },
+            "machine": None
+            if self.machine is None
+            else {f: vars(t) for f, t in (self.flank_tables() or {}).items()},
         }
 
 
@@ -860,7 +883,16 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     if kind not in GEAR_KINDS:
         raise InputError("case.kind", kind, f"one of {GEAR_KINDS}")
     case_s, pair_s, load_s, errors_s, analysis_s, material_s, contact_s = sections(kind)
-    check_document(data, sections(kind))
+    machine = data.get("machine") if kind in BEVEL_KINDS else None
+    check_document({k: v for k, v in data.items() if machine is None or k != "machine"},
+                   sections(kind))  # fmt: skip
+    if machine is not None:
+        parse_machine(machine)  # refused here, naming machine.<flank>.<key>
+        for key in SYNTHESIS_KEYS:
+            if key in data["pair"]:
+                raise InputError(f"pair.{key}", data["pair"][key], "absent with [machine]",
+                                 "it steers the synthesis of the settings, which [machine] "
+                                 "gives")  # fmt: skip
     for_kind = f" for kind {kind!r}"
     case = check_table(case_s, data["case"])
     pair = _check_pair(kind, check_table(pair_s, data["pair"], for_kind))
@@ -923,6 +955,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         speed_rpm=float(load["speed_rpm"]) if "speed_rpm" in load else None,
         description=case_s.value(case, "description"),
         source=source,
+        machine=copy.deepcopy(machine),
     )
 
 

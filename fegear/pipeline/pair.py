@@ -19,6 +19,7 @@ from typing import Any, Protocol
 from fegear.errors import DesignError, InputError
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
 from fegear.geometry.bevel import SpiralBevelBlank, SpiralBevelPair, SynthesisTargets
+from fegear.geometry.bevel.sheet import FlankTable, settings_from_tables
 from fegear.geometry.cylindrical import CylindricalMember, FlankModifications, signed_helix_deg
 from fegear.geometry.design_checks import validate_involute_pair
 from fegear.geometry.pair_placement import (
@@ -307,12 +308,20 @@ class SpiralBevelFamily:
         target_kw = {}
         if "te_amplitude_arcsec" in p:
             target_kw["te_amplitude_arcsec"] = float(p["te_amplitude_arcsec"])
-        key = (tuple(sorted(blank_kw.items())), tuple(sorted(target_kw.items())))
+        tables = case.flank_tables()
+        machine = None if tables is None else {f: vars(t) for f, t in tables.items()}
+        key = (
+            tuple(sorted(blank_kw.items())),
+            tuple(sorted(target_kw.items())),
+            json.dumps(machine, sort_keys=True),
+        )
         try:
             if key not in self._pairs:
-                self._pairs[key] = _bevel_pair(blank_kw, target_kw)
+                self._pairs[key] = _bevel_pair(blank_kw, target_kw, machine)
             sb = self._pairs[key]
         except InputError as exc:
+            if exc.field.startswith("machine."):
+                raise
             raise _renamed(exc, None, self._fields, case) from exc
         side = PAIR_SECTIONS["spiral_bevel"].value(p, "side")
         return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
@@ -322,10 +331,12 @@ class SpiralBevelFamily:
         return spiral_bevel_assembly(pair.spiral_bevel, side, errors)
 
 
-def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
-    """The synthesized spiral bevel pair of the blank data: read from the artefact cache when
-    the same blank and targets were synthesized before by the same geometry code (the synthesis
-    takes 10-20 s), else synthesized and cached. The entry is the pair's plain-data record
+def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: dict | None):
+    """The bevel pair of the blank data, its settings synthesized (``machine`` None) or given
+    (``machine``: the flank tables of :mod:`fegear.geometry.bevel.sheet` as plain dicts, mm and
+    deg): read from the artefact cache when the same pair was built before by the same geometry
+    code (the synthesis takes 10-20 s, settings from tables about 8 s), else built and cached.
+    The entry is the pair's plain-data record
     (:meth:`~fegear.geometry.bevel.SpiralBevelPair.record`, JSON: no pickle); the key
     holds the code version of ``fegear.geometry`` and the numpy and scipy versions
     (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis invalidates it."""
@@ -333,12 +344,17 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any]):
 
     def build(path: Path) -> None:
         # a design error raises here, before anything is written (nothing is cached)
-        box["pair"] = SpiralBevelPair.design(
-            SpiralBevelBlank(**blank_kw), SynthesisTargets(**target_kw)
-        )
+        blank = SpiralBevelBlank(**blank_kw)
+        if machine is None:
+            box["pair"] = SpiralBevelPair.design(blank, SynthesisTargets(**target_kw))
+        else:
+            tables = {f: FlankTable(**t) for f, t in machine.items()}
+            box["pair"] = SpiralBevelPair.from_settings(blank, settings_from_tables(blank, tables))
         path.write_text(json.dumps(box["pair"].record()), encoding="utf-8")
 
     params = {"blank": blank_kw, "targets": target_kw}
+    if machine is not None:
+        params["machine"] = machine
     path, hit = cached_file("bevel_pair", params, ".json", build)
     if not hit:
         return box["pair"]

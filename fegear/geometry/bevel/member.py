@@ -274,7 +274,13 @@ class SpiralBevelMember:
     def _find_reference(self, side: Side) -> tuple[float, float, float]:
         tool, mot = self._tools(side)
         g, rm = self.pitch_angle, self.blank.mean_cone_distance(self.index)
-        e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        glog = logging.getLogger(generate.__module__)
+        level = glog.level
+        glog.setLevel(max(level, logging.ERROR))  # (0, 0, 0) may generate nothing: then search
+        try:
+            e0 = generate(tool, mot, 0.0, 0.0, 0.0, half_width=0.3)
+        finally:
+            glog.setLevel(level)
         L0, h0, _, _ = cone_coords(e0.points, g)
         if bool(e0.residual < 1e-9) and math.hypot(L0 - rm, h0) < 1e-9:
             return 0.0, 0.0, 0.0
@@ -283,7 +289,13 @@ class SpiralBevelMember:
             np.linspace(-depth, 2.0 * depth, 7), np.linspace(-1.2, 1.2, 49),
             np.linspace(-1.0, 1.0, 9), indexing="ij",
         )  # fmt: skip
-        env = generate(tool, mot, S, T, P, half_width=0.125)
+        glog = logging.getLogger(generate.__module__)
+        level = glog.level
+        glog.setLevel(max(level, logging.ERROR))  # most of the wide grid has no root: expected
+        try:
+            env = generate(tool, mot, S, T, P, half_width=0.125)
+        finally:
+            glog.setLevel(level)
         L, h, _, _ = cone_coords(env.points, g)
         miss = np.where(env.residual < 1e-9, np.hypot(L - rm, h), np.inf)
         k = np.unravel_index(int(np.argmin(miss)), miss.shape)

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...errors import InputError
+from ...errors import DesignError, InputError, SolverError
 from ..generation import generate
 from ..surface import Side
 from ..transforms import apply_points, apply_vectors
@@ -121,8 +121,15 @@ class SpiralBevelPair:
         pair = cls(blank, SynthesisTargets(), settings, {}, pinion, gear, placements)
         if check:
             for m in (pair.pinion, pair.gear):
-                m.check_fillets()
-                m.check_tooth()
+                try:
+                    m.check_fillets()
+                    m.check_tooth()
+                except (DesignError, SolverError) as exc:
+                    raise DesignError(
+                        f"machine.{m.name}_drive / machine.{m.name}_coast", "these settings",
+                        f"settings that cut a {m.name} tooth (fillets that fit in the tooth "
+                        "space, neither pointed nor undercut)", str(exc),
+                    ) from exc  # fmt: skip
         return pair
 
     @classmethod

@@ -98,12 +98,17 @@ def flank_table(blank, i: int, ms: MachineSettings) -> FlankTable:
     cradle axis is a shift of the work the other way: the sliding base)."""
     zp = ms.point_plane_mm if ms.point_plane_mm is not None else point_plane(blank, i, ms)
     tip = ms.ref_height_mm + zp  # z_m of the blade tips
+    radius, height = ms.cutter_radius_mm, -zp
+    if ms.parabola_per_mm == 0.0:  # a straight blade: its radius at the tip, the point radius
+        sg = 1.0 if ms.blade == "outside" else -1.0
+        radius, height = radius - sg * height * math.tan(math.radians(ms.blade_angle_deg)), 0.0
+    slide = ms.sliding_base_mm - tip
     return FlankTable(
-        blade=ms.blade, blade_angle_deg=ms.blade_angle_deg, blade_radius_mm=ms.cutter_radius_mm,
+        blade=ms.blade, blade_angle_deg=ms.blade_angle_deg, blade_radius_mm=radius,
         edge_radius_mm=ms.edge_radius_mm, radial_mm=ms.radial_setting_mm,
         cradle_angle_deg=ms.cradle_angle_deg, machine_root_angle_deg=ms.machine_root_angle_deg,
-        ratio_of_roll=ms.ratio_of_roll, blade_height_mm=-zp, parabola_per_mm=ms.parabola_per_mm,
-        blank_offset_mm=ms.blank_offset_mm, sliding_base_mm=ms.sliding_base_mm - tip,
+        ratio_of_roll=ms.ratio_of_roll, blade_height_mm=height, parabola_per_mm=ms.parabola_per_mm,
+        blank_offset_mm=ms.blank_offset_mm, sliding_base_mm=0.0 if abs(slide) < 1e-9 else slide,
         machine_center_to_apex_mm=ms.machine_center_to_back_mm,
         modified_roll_2C=ms.modified_roll, modified_roll_6D=ms.modified_roll_third,
     )  # fmt: skip
