@@ -26,6 +26,7 @@ from fegear.api.compare import plot_patterns, plot_te, table
 from fegear.api.gear_result import GearResult
 from fegear.api.hertz_scene_result import HertzResult
 from fegear.api.runner import Progress, load_case, run
+from fegear.api.settings import machine_sheet, machine_tables
 from fegear.results.model import Checks, Cycle, Excluded, PairLoad, Position
 
 __all__ = [
@@ -38,6 +39,8 @@ __all__ = [
     "Position",
     "Progress",
     "load_case",
+    "machine_sheet",
+    "machine_tables",
     "plot_patterns",
     "plot_te",
     "run",

@@ -12,9 +12,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from fegear import __version__
-from fegear.errors import InputError
-
 __all__ = ["add_parser", "run"]
 
 
@@ -34,26 +31,11 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the subcommand; the exit code."""
-    # local: the geometry pulls scipy (~1 s); the `fegear` command builds its parser from here
-    from fegear.api import load_case
-    from fegear.geometry.bevel.sheet import FLANKS, flank_table
-    from fegear.io.gear_case import BEVEL_KINDS
-    from fegear.io.machine_table import format_machine
-    from fegear.pipeline.pair import build_pair
+    # local: the API pulls the geometry and scipy (~1 s); the `fegear` command builds its
+    # parser from this module
+    from fegear.api import load_case, machine_sheet
 
-    case = load_case(args.case)
-    if getattr(case, "kind", None) not in BEVEL_KINDS:
-        raise InputError("case.kind", getattr(case, "kind", None), f"one of {BEVEL_KINDS}")
-    pair = build_pair(case).spiral_bevel
-    tables = {
-        f: flank_table(
-            pair.blank, 1 if f.startswith("pinion") else 2, pair.settings.get(*f.split("_"))
-        )
-        for f in FLANKS
-    }
-    how = "as given in the case" if case.machine is not None else "synthesized by fegear"
-    title = f"machine settings of {case.name!r} ({case.source}), {how}; fegear {__version__}"
-    text = format_machine(tables, args.units, title)
+    text = machine_sheet(load_case(args.case), args.units)
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")
         print(f"wrote {args.out}", file=sys.stderr)

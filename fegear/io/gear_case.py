@@ -797,9 +797,11 @@ class GearCase:
             "contact": {
                 k: list(v) if isinstance(v, tuple) else v for k, v in self.contact.as_dict().items()
             },
-            "machine": None
-            if self.machine is None
-            else {f: vars(t) for f, t in (self.flank_tables() or {}).items()},
+            **(
+                {}
+                if self.machine is None
+                else {"machine": {f: vars(t) for f, t in (self.flank_tables() or {}).items()}}
+            ),
         }
 
 

@@ -331,7 +331,7 @@ class SpiralBevelFamily:
         return spiral_bevel_assembly(pair.spiral_bevel, side, errors)
 
 
-def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: dict | None):
+def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: dict | None = None):
     """The bevel pair of the blank data, its settings synthesized (``machine`` None) or given
     (``machine``: the flank tables of :mod:`fegear.geometry.bevel.sheet` as plain dicts, mm and
     deg): read from the artefact cache when the same pair was built before by the same geometry

@@ -13,11 +13,13 @@ terms of bevel practice:
 - **First-order TE shift** (envelope theorem): a small rigid displacement of the pinion relative
   to the gear that moves the pinion contact point ``M`` by ``δr`` changes the gap at ``M`` along
   the gear normal ``n`` (out of the gear tooth) by ``δr · n``; a lag ``θ`` of the gear closes it
-  by ``θ h`` with ``h = (σ e2 × M) · n`` (gear rotation axis ``−σ e2`` in its driving sense), so
-  ``ΔTE = −θ = −(δr · n)/h`` at ``φ1 = 0`` to first order, whatever the contact point shift
-  (the gap is stationary at the contact point). With the conventions of
-  :mod:`fegear.geometry.pair_placement`: ``δr = ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the
-  gear moves), ``(−Δγ e_y) × M`` (Δγ, pinion axis turned about ``e_y`` through the apex by ``−Δγ``).
+  by ``θ h`` with ``h = (σ e2 × (M − A2)) · n`` (gear rotation axis ``−σ e2`` through the gear
+  apex ``A2`` in its driving sense), so ``ΔTE = −θ = −(δr · n)/h`` at ``φ1 = 0`` to first order,
+  whatever the contact point shift (the gap is stationary at the contact point). ``δr`` is the
+  displacement of the pinion relative to the gear at ``M`` that the assembly's error transforms
+  make (:func:`fegear.geometry.pair_placement.spiral_bevel_assembly`): for intersecting axes
+  ``ΔE e_y`` (ΔE), ``ΔP e_z`` (ΔP), ``−ΔG e2`` (ΔG, the gear moves), ``(−Δγ e_y) × M`` (Δγ,
+  pinion axis turned about ``e_y`` through the apex by ``−Δγ``), to first order.
 """
 
 from __future__ import annotations
@@ -124,12 +126,12 @@ def first_order_te_shift(pair, side: str, errors: InstallationErrors) -> float:
     """First-order TE change (arcsec) at ``φ1 = 0`` caused by ``errors`` (module docstring)."""
     rep = pair.reports[side]
     M, n, sigma = np.asarray(rep.point), np.asarray(rep.normal), rep.sigma
-    S = math.radians(pair.blank.shaft_angle_deg)
-    e2 = np.array([math.sin(S), 0.0, math.cos(S)])
-    ey, ez = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
-    dg = math.radians(errors.dgamma_deg)
-    dr = errors.dE_mm * ey + errors.dA1_mm * ez - errors.dA2_mm * e2 + np.cross(-dg * ey, M)
-    h = float(np.dot(np.cross(sigma * e2, M), n))
+    A2, e2 = pair.blank.gear_axis()
+    a0, a1 = spiral_bevel_assembly(pair, side), spiral_bevel_assembly(pair, side, errors)
+    move1 = apply_points(a1.base1 @ inverse(a0.base1), M)  # the pinion's point M, moved
+    move2 = apply_points(a1.base2 @ inverse(a0.base2), M)  # the gear's point M, moved
+    dr = move1 - move2
+    h = float(np.dot(np.cross(sigma * e2, M - A2), n))
     return float(-np.dot(dr, n) / h / ARCSEC)
 
 
@@ -209,10 +211,10 @@ def path_angle_on_gear(pair, side: str = "drive", dphi: float = 0.02) -> tuple[f
     d = pts[1] - pts[0]
     rep = pair.reports[side]
     M, t, n = (np.asarray(x, dtype=float) for x in (rep.point, rep.path_direction, rep.normal))
-    S = math.radians(pair.blank.shaft_angle_deg)
-    e2 = np.array([math.sin(S), 0.0, math.cos(S)])
-    radial = M - e2 * np.dot(M, e2)
-    ep = radial - M * np.dot(radial, M) / np.dot(M, M)  # gear pitch-cone normal (toward tip)
+    A2, e2 = pair.blank.gear_axis()
+    r2 = M - A2
+    radial = r2 - e2 * np.dot(r2, e2)
+    ep = radial - r2 * np.dot(radial, r2) / np.dot(r2, r2)  # gear pitch-cone normal (toward tip)
     w = np.cross(n, t)
     w = w if np.dot(w, ep) > 0 else -w
     tgt = pair.targets

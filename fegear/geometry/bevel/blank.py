@@ -65,8 +65,7 @@ class SpiralBevelBlank:
     module_mm
         Outer (heel) transverse module (mm); 4.94 mm = 5.14 diametral pitch.
     spiral_angle_deg
-        Mean spiral angle β, in [0, 50]. The gear is right-hand (trace turns towards +θ going
-        toe → heel, i.e. clockwise seen from the front), the pinion left-hand.
+        Mean spiral angle β, in [0, 50].
     pressure_angle_deg
         Normal pressure angle α at the mean point, both flanks, in [10, 30].
     face_width_mm
@@ -91,6 +90,11 @@ class SpiralBevelBlank:
         1.235 mm does not fit: 0.81 mm (0.164 m) it is. A radius whose fillets do not fit in a
         tooth space (more than the blade points can carry) is refused
         (:meth:`~fegear.geometry.bevel.member.SpiralBevelMember.check_fillets`).
+    hand
+        Hand of the gear's spiral, ``"right"`` (default: the tooth trace turns towards +θ going
+        toe → heel, clockwise seen from the front) or ``"left"``; the pinion has the other hand.
+        A left-hand pair is the mirror image of the right-hand one
+        (:meth:`~fegear.geometry.bevel.pair.SpiralBevelPair.mirrored`).
     """
 
     n1: int = 12
@@ -102,10 +106,13 @@ class SpiralBevelBlank:
     shaft_angle_deg: float = 90.0
     cutter_radius_mm: float = 76.2
     edge_radius_mm: float | None = None
+    hand: str = "right"
     #: prefix of the field names in this blank's errors
     field_prefix: ClassVar[str] = "spiral_bevel"
 
     def __post_init__(self) -> None:
+        if self.hand not in ("right", "left"):
+            raise InputError(f"{self.field_prefix}.hand", self.hand, "'right' or 'left'")
         for name in ("n1", "n2"):
             v = getattr(self, name)
             if not isinstance(v, int | np.integer) or v < 5:

@@ -23,7 +23,7 @@ holds for any tool normal.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,6 +41,7 @@ __all__ = [
     "blank_placement",
     "machine_motion",
     "fit_cutter",
+    "mirrored",
 ]
 
 Array = NDArray[np.float64]
@@ -291,4 +292,24 @@ def fit_cutter(
         blank_phase_deg=math.degrees(blank_phase),
         ratio_of_roll=float(ratio_of_roll),
         modified_roll=float(modified_roll),
+    )
+
+
+def mirrored(ms: MachineSettings) -> MachineSettings:
+    """The settings that cut the mirror image (``y → −y`` in the member frame) of the flank
+    ``ms`` cuts: the other hand.
+
+    The reflection ``Y = diag(1, −1, 1)`` of the machine frame maps the cradle chain of
+    :func:`machine_motion` onto itself with ``rot_z(a) → rot_z(−a)`` and ``y`` offsets negated;
+    the head cutter, a surface of revolution, is its own mirror image (``θ → −θ``). With the
+    cradle angle ``ψ → −ψ`` the roll ``−φ(−ψ) = −m (ψ + C ψ²/2 − D ψ³/6)``: so ``q → −q``,
+    ``E_m → −E_m``, ``φ0 → −φ0``, ``θ0 → −θ0``, ``C → −C``; the rest is unchanged.
+    """
+    return replace(
+        ms,
+        cradle_angle_deg=-ms.cradle_angle_deg,
+        blank_offset_mm=-ms.blank_offset_mm,
+        blank_phase_deg=-ms.blank_phase_deg,
+        tool_phase_deg=-ms.tool_phase_deg,
+        modified_roll=-ms.modified_roll,
     )

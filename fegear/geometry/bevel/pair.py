@@ -22,7 +22,7 @@ from ..generation import generate
 from ..surface import Side
 from ..transforms import apply_points, apply_vectors
 from .blank import ARCSEC, SpiralBevelBlank
-from .machine import MachineSettings, SpiralBevelSettings
+from .machine import MachineSettings, SpiralBevelSettings, mirrored
 from .member import SpiralBevelMember
 from .mesh_frame import mesh_transforms
 from .synthesis import SynthesisReport, SynthesisTargets, synthesize
@@ -82,9 +82,14 @@ class SpiralBevelPair:
     ) -> SpiralBevelPair:
         """Synthesize the machine settings (unless given) and build both members; choose the
         blade edge radius if the blank leaves it open (:func:`_default_edge_radius`); refuse an
-        edge radius whose fillets do not fit (:meth:`SpiralBevelMember.check_fillets`)."""
+        edge radius whose fillets do not fit (:meth:`SpiralBevelMember.check_fillets`). A
+        left-hand gear is the mirror image of the right-hand pair (:meth:`mirrored`)."""
         blank = blank or SpiralBevelBlank()
         targets = targets or SynthesisTargets()
+        if blank.hand == "left":
+            right = replace(blank, hand="right")
+            given = None if settings is None else _mirror_settings(settings)
+            return cls.design(right, targets, given).mirrored(blank)
         synth, reports = synthesize(blank, targets)
         synth_final = None
         if settings is None:
@@ -140,6 +145,38 @@ class SpiralBevelPair:
             for side, r in reports.items()
         }
         return cls(blank, targets, settings, reports, pinion, gear, placements)
+
+    def mirrored(self, blank) -> SpiralBevelPair:
+        """The mirror image of the pair (``y → −y`` in the mesh frame and in every member
+        frame) on ``blank`` (the same blank of the other hand): settings mirrored
+        (:func:`~.machine.mirrored`), each side's pinion turning the other way (σ → −σ), flank
+        angles, points, normals and path directions mirrored; the relative curvatures and shape
+        operators in the basis ``(t, n × t)`` change the sign of their off-diagonal entry
+        (``n × t`` of mirrored vectors is minus the mirrored ``n × t``)."""
+        Y = np.array([1.0, -1.0, 1.0])
+        flip = np.array([[1.0, -1.0], [-1.0, 1.0]])
+        reports = {
+            side: replace(
+                r,
+                sigma=-r.sigma,
+                point=r.point * Y,
+                normal=r.normal * Y,
+                path_direction=r.path_direction * Y,
+                relative_curvature=r.relative_curvature * flip,
+                target_pinion_shape=r.target_pinion_shape * flip,
+                achieved_pinion_shape=r.achieved_pinion_shape * flip,
+                gear_flank_angle=-r.gear_flank_angle,
+                pinion_flank_angle=-r.pinion_flank_angle,
+            )  # fmt: skip
+            for side, r in self.reports.items()
+        }
+        settings = _mirror_settings(self.settings)
+        pinion, gear = _members(blank, settings)
+        placements = {
+            side: FlankPlacement(side, -r.sigma, -r.gear_flank_angle, -r.pinion_flank_angle)
+            for side, r in self.placements.items()
+        }
+        return type(self)(blank, self.targets, settings, reports, pinion, gear, placements)
 
     def record(self) -> dict[str, Any]:
         """The pair as plain data (JSON-ready: numbers, strings, lists): blank, targets, machine
@@ -203,6 +240,13 @@ class SpiralBevelPair:
 
 _RECORD_FORMAT = "fegear.spiral_bevel_pair/1"
 SIDES = ("drive", "coast")
+
+
+def _mirror_settings(settings: SpiralBevelSettings) -> SpiralBevelSettings:
+    return SpiralBevelSettings(**{f: mirrored(getattr(settings, f)) for f in _FLANKS})
+
+
+_FLANKS = ("gear_drive", "gear_coast", "pinion_drive", "pinion_coast")
 
 
 def _members(blank, settings: SpiralBevelSettings) -> tuple[SpiralBevelMember, SpiralBevelMember]:
