@@ -174,7 +174,93 @@ _CYLINDRICAL = Section(
     required=True,
 )  # fmt: skip
 
+
 #: ``[pair]`` by kind (design data; the geometry checks the rest: undercut, pointing).
+def _bevel_keys(hypoid: bool) -> tuple[Key, ...]:
+    """The ``[pair]`` keys of a face-milled bevel pair: a spiral bevel, or a hypoid (its offset,
+    the pinion's spiral angle and face width)."""
+    keys = (
+        Key("n_pinion", INTEGER, "pinion teeth (member 1, <= n_gear)", True, range=_TEETH),
+        Key("n_gear", INTEGER, "gear teeth", True, range=_TEETH),
+        Key("module_mm", NUMBER, "outer transverse module, mm", True, range=_POS),
+        Key(
+            "spiral_angle_deg",
+            NUMBER,
+            "mean spiral angle, deg",
+            True,
+            range=Range(0, 50, unit=_DEG),
+        ),
+        Key(
+            "pressure_angle_deg",
+            NUMBER,
+            "pressure angle, deg",
+            True,
+            range=Range(10, 30, unit=_DEG),
+        ),
+        Key("face_width_mm", NUMBER, "face width, mm", True, range=_POS),
+        Key(
+            "shaft_angle_deg",
+            NUMBER,
+            "shaft angle, deg",
+            default=_design_default(SpiralBevelBlank, "shaft_angle_deg"),
+            range=Range(0, 180, lo_open=True, hi_open=True, unit=_DEG),
+        ),
+        Key(
+            "cutter_radius_mm",
+            NUMBER,
+            "gear head-cutter radius, mm",
+            default=_design_default(SpiralBevelBlank, "cutter_radius_mm"),
+            range=_POS,
+        ),
+        Key(
+            "edge_radius_mm",
+            NUMBER,
+            "blade edge radius (generates the fillet), mm "
+            "(default: 0.25 m where the tooth spaces carry it, else 80 % of the largest "
+            "they carry)",
+            range=_POS,
+        ),
+        Key(
+            "te_amplitude_arcsec",
+            NUMBER,
+            "predesigned parabolic TE amplitude, arcsec",
+            default=_design_default(SynthesisTargets, "te_amplitude_arcsec"),
+            range=Range(0, 60, lo_open=True, unit="arcsec"),
+        ),
+        Key(
+            "side",
+            STRING,
+            "the flank pair that drives",
+            default="drive",
+            choices=("drive", "coast"),
+        ),
+        Key(
+            "hand",
+            STRING,
+            "hand of the gear's spiral (the pinion has the other)",
+            default=_design_default(SpiralBevelBlank, "hand"),
+            choices=("right", "left"),
+        ),
+    )
+    if not hypoid:
+        return keys
+    offset = (
+        Key("offset_mm", NUMBER, "hypoid offset E: shortest distance between the axes, mm", True,
+            range=_POS),
+        Key("pinion_face_width_mm", NUMBER, "pinion face width, mm (default: as the hypoid blank "
+            "places it to cover the gear face)", range=_POS),
+    )  # fmt: skip
+    return (
+        tuple(
+            Key(k.name, k.type, "pinion mean spiral angle, deg", True, range=k.range)
+            if k.name == "spiral_angle_deg"
+            else k
+            for k in keys
+        )
+        + offset
+    )
+
+
 PAIR_SECTIONS: dict[str, Section] = {
     "face_gear": Section(
         "pair",
@@ -313,63 +399,9 @@ PAIR_SECTIONS: dict[str, Section] = {
     "cylindrical": _CYLINDRICAL,
     "spiral_bevel": Section(
         "pair",
-        (
-            Key("n_pinion", INTEGER, "pinion teeth (member 1, <= n_gear)", True, range=_TEETH),
-            Key("n_gear", INTEGER, "gear teeth", True, range=_TEETH),
-            Key("module_mm", NUMBER, "outer transverse module, mm", True, range=_POS),
-            Key(
-                "spiral_angle_deg",
-                NUMBER,
-                "mean spiral angle, deg",
-                True,
-                range=Range(0, 50, unit=_DEG),
-            ),
-            Key(
-                "pressure_angle_deg",
-                NUMBER,
-                "pressure angle, deg",
-                True,
-                range=Range(10, 30, unit=_DEG),
-            ),
-            Key("face_width_mm", NUMBER, "face width, mm", True, range=_POS),
-            Key(
-                "shaft_angle_deg",
-                NUMBER,
-                "shaft angle, deg",
-                default=_design_default(SpiralBevelBlank, "shaft_angle_deg"),
-                range=Range(0, 180, lo_open=True, hi_open=True, unit=_DEG),
-            ),
-            Key(
-                "cutter_radius_mm",
-                NUMBER,
-                "gear head-cutter radius, mm",
-                default=_design_default(SpiralBevelBlank, "cutter_radius_mm"),
-                range=_POS,
-            ),
-            Key(
-                "edge_radius_mm",
-                NUMBER,
-                "blade edge radius (generates the fillet), mm "
-                "(default: 0.25 m where the tooth spaces carry it, else 80 % of the largest "
-                "they carry)",
-                range=_POS,
-            ),
-            Key(
-                "te_amplitude_arcsec",
-                NUMBER,
-                "predesigned parabolic TE amplitude, arcsec",
-                default=_design_default(SynthesisTargets, "te_amplitude_arcsec"),
-                range=Range(0, 60, lo_open=True, unit="arcsec"),
-            ),
-            Key(
-                "side",
-                STRING,
-                "the flank pair that drives",
-                default="drive",
-                choices=("drive", "coast"),
-            ),
-        ),
-        "Spiral bevel blank data (face-milled): the machine settings are synthesized.",
+        _bevel_keys(hypoid=False),
+        "Spiral bevel blank data (face-milled): the machine settings are synthesized, or "
+        "given in [machine] tables.",
         required=True,
     ),
 }

@@ -305,6 +305,8 @@ class SpiralBevelFamily:
         for k in ("shaft_angle_deg", "cutter_radius_mm", "edge_radius_mm"):
             if k in p:
                 blank_kw[k] = float(p[k])
+        if p.get("hand", "right") != "right":
+            blank_kw["hand"] = p["hand"]
         target_kw = {}
         if "te_amplitude_arcsec" in p:
             target_kw["te_amplitude_arcsec"] = float(p["te_amplitude_arcsec"])
@@ -340,6 +342,10 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: di
     (:meth:`~fegear.geometry.bevel.SpiralBevelPair.record`, JSON: no pickle); the key
     holds the code version of ``fegear.geometry`` and the numpy and scipy versions
     (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis invalidates it."""
+    if machine is None and blank_kw.get("hand", "right") == "left":
+        # the mirror image of the right-hand pair (its synthesis cached under its own data)
+        right = _bevel_pair({k: v for k, v in blank_kw.items() if k != "hand"}, target_kw)
+        return right.mirrored(SpiralBevelBlank(**blank_kw))
     box: dict[str, Any] = {}
 
     def build(path: Path) -> None:
