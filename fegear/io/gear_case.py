@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from fegear.errors import InputError
-from fegear.geometry.bevel import SpiralBevelBlank, SynthesisTargets
+from fegear.geometry.bevel import HypoidBlank, SpiralBevelBlank, SynthesisTargets
 from fegear.geometry.bevel.sheet import FlankTable
 from fegear.geometry.cylindrical import RELIEF_SHAPES
 from fegear.geometry.face_gear import FaceGearDesign
@@ -67,12 +67,19 @@ __all__ = [
     "sections",
 ]
 
-GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel")
+GEAR_KINDS = ("face_gear", "spur", "cylindrical", "spiral_bevel", "hypoid")
 #: Kinds whose flanks a face-milling machine cuts: their ``[machine]`` section may give the
 #: settings (:mod:`fegear.io.machine_table`).
-BEVEL_KINDS = ("spiral_bevel",)
-#: ``[pair]`` keys of the synthesis of the settings: not used with a ``[machine]`` section.
+BEVEL_KINDS = ("spiral_bevel", "hypoid")
+#: ``[pair]`` keys of the synthesis of the settings: not used with a ``[machine]`` section
+#: (a hypoid's cutter radius stays: it fixes the pitch cones, :func:`synthesis_keys`).
 SYNTHESIS_KEYS = ("cutter_radius_mm", "te_amplitude_arcsec")
+
+
+def synthesis_keys(kind: str) -> tuple[str, ...]:
+    """The :data:`SYNTHESIS_KEYS` of a bevel kind (a hypoid's blank needs its cutter radius:
+    the limit condition of its pitch cones, :mod:`fegear.geometry.bevel.hypoid_cones`)."""
+    return SYNTHESIS_KEYS if kind != "hypoid" else ("te_amplitude_arcsec",)
 #: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
 PARALLEL_KINDS = ("spur", "cylindrical")
 #: Fidelities of the gear pairs (``docs/fidelity.md``).
@@ -245,14 +252,20 @@ def _bevel_keys(hypoid: bool) -> tuple[Key, ...]:
     if not hypoid:
         return keys
     offset = (
-        Key("offset_mm", NUMBER, "hypoid offset E: shortest distance between the axes, mm", True,
-            range=_POS),
+        Key("offset_mm", NUMBER, "hypoid offset E: shortest distance between the axes, mm "
+            "(the gear's hand puts the pinion on the usual side: pinion spiral angle > gear's)",
+            True, range=Range(0, None, unit="mm")),
         Key("pinion_face_width_mm", NUMBER, "pinion face width, mm (default: as the hypoid blank "
             "places it to cover the gear face)", range=_POS),
+        Key("limit_pressure_angle_factor", NUMBER, "ISO 23509 f_alim: the flank pressure "
+            "angles are alpha -/+ f_alim alpha_lim (drive/coast)",
+            default=_design_default(HypoidBlank, "limit_pressure_angle_factor"),
+            range=Range(0, 1)),
     )  # fmt: skip
     return (
         tuple(
-            Key(k.name, k.type, "pinion mean spiral angle, deg", True, range=k.range)
+            Key(k.name, k.type, "pinion mean spiral angle, deg", True,
+                range=Range(0, 60, unit=_DEG))
             if k.name == "spiral_angle_deg"
             else k
             for k in keys
@@ -404,8 +417,16 @@ PAIR_SECTIONS: dict[str, Section] = {
         "given in [machine] tables.",
         required=True,
     ),
+    "hypoid": Section(
+        "pair",
+        _bevel_keys(hypoid=True),
+        "Hypoid blank data (face-milled, pitch cones of ISO 23509 method 1 with the gear "
+        "cutter radius as the limit radius): the machine settings are synthesized, or given "
+        "in [machine] tables.",
+        required=True,
+    ),
 }
-_INTERSECTING = "intersecting axes (face gear, spiral bevel)"
+_INTERSECTING = "intersecting or crossed axes (face gear, spiral bevel, hypoid)"
 _PARALLEL = "parallel axes (spur, cylindrical)"
 #: ``[errors]`` by axis arrangement (sign conventions: :mod:`fegear.geometry.pair_placement`).
 ERROR_KEYS: dict[str, tuple[Key, ...]] = {
@@ -889,7 +910,7 @@ def _check_pair(kind: str, p: dict[str, Any]) -> dict[str, Any]:
             p["outer_radius_mm"],
             f"> pair.inner_radius_mm = {p['inner_radius_mm']}",
         )
-    if kind == "spiral_bevel" and p["n_pinion"] > p["n_gear"]:
+    if kind in BEVEL_KINDS and p["n_pinion"] > p["n_gear"]:
         raise InputError(
             "pair.n_pinion", p["n_pinion"], f"<= pair.n_gear = {p['n_gear']} (member 1)"
         )
@@ -922,7 +943,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
                    sections(kind))  # fmt: skip
     if machine is not None:
         parse_machine(machine)  # refused here, naming machine.<flank>.<key>
-        for key in SYNTHESIS_KEYS:
+        for key in synthesis_keys(kind):
             if key in data["pair"]:
                 raise InputError(f"pair.{key}", data["pair"][key], "absent with [machine]",
                                  "it steers the synthesis of the settings, which [machine] "

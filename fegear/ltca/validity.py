@@ -61,7 +61,7 @@ APPROACH_LIMIT = 0.02
 P_ELASTIC_LIMIT_MPA = 4000.0
 #: Gear kinds whose contact is localized by design (a patch over the whole face width is out of
 #: range for them; a spur pair's line contact runs over the face width by design).
-LOCALIZED = ("face_gear", "spiral_bevel")
+LOCALIZED = ("face_gear", "spiral_bevel", "hypoid")
 
 # EDGE_TAGS bits (fegear.ltca.grid): the two ends of the active profile on the pinion's flank,
 # and the face ends of each member.

@@ -3,8 +3,8 @@
 A gear family is a :class:`Family`: it turns the ``[pair]`` table of a validated
 :class:`~fegear.io.gear_case.GearCase` into the generated members (objects of the
 :class:`~fegear.geometry.surface.GeneratedMember` protocol) and assembles them with installation
-errors. The pipeline reaches a family only through :data:`FAMILIES`, so a new family (hypoid)
-is one more :class:`Family` here, its ``[pair]`` section in
+errors. The pipeline reaches a family only through :data:`FAMILIES`, so a new family is one
+more :class:`Family` here (as the hypoid is: the spiral bevel's on another blank), its ``[pair]`` section in
 :mod:`fegear.io.gear_case` and its members in :mod:`fegear.geometry`; everything downstream of
 the pair (TCA, meshes, compliance, contact) works on the member protocol.
 """
@@ -18,7 +18,7 @@ from typing import Any, Protocol
 
 from fegear.errors import DesignError, InputError
 from fegear.geometry import FaceGearDesign, FaceGearMember, InvoluteDesign, InvoluteMember
-from fegear.geometry.bevel import SpiralBevelBlank, SpiralBevelPair, SynthesisTargets
+from fegear.geometry.bevel import HypoidBlank, SpiralBevelBlank, SpiralBevelPair, SynthesisTargets
 from fegear.geometry.bevel.sheet import FlankTable, settings_from_tables
 from fegear.geometry.cylindrical import CylindricalMember, FlankModifications, signed_helix_deg
 from fegear.geometry.design_checks import validate_involute_pair
@@ -46,8 +46,8 @@ class GearPair:
     assembly
         Their :class:`~fegear.geometry.pair_placement.Assembly` with the case's installation errors.
     spiral_bevel
-        The synthesized :class:`~fegear.geometry.bevel.SpiralBevelPair` (spiral bevel
-        cases only, else None): what re-assembling with other errors needs.
+        The :class:`~fegear.geometry.bevel.SpiralBevelPair` (spiral bevel and hypoid cases
+        only, else None): what re-assembling with other errors needs.
     """
 
     pinion: Any
@@ -283,18 +283,21 @@ def _as_diameter(exc: InputError) -> InputError:
 
 class SpiralBevelFamily:
     """Face-milled spiral bevel pair, synthesized from its blank data (machine settings for a
-    predesigned parabolic transmission error). The synthesis (10-20 s) is kept per process and
-    in the artefact cache for the same blank data."""
+    predesigned parabolic transmission error) or cut by the [machine] tables. The synthesis
+    (10-20 s) is kept per process and in the artefact cache for the same blank data."""
 
     kind = "spiral_bevel"
+    blank_type: type = SpiralBevelBlank
     _fields = {"n1": "n_pinion", "n2": "n_gear", "te_amplitude_arcsec": "te_amplitude_arcsec"}
+    #: optional ``[pair]`` numbers passed to the blank under the same name
+    _optional = ("shaft_angle_deg", "cutter_radius_mm", "edge_radius_mm")
 
     def __init__(self) -> None:
         self._pairs: dict[tuple, Any] = {}
 
-    def build(self, case: GearCase) -> GearPair:
-        p = case.pair
-        blank_kw: dict[str, Any] = {
+    def blank_kw(self, p: dict[str, Any]) -> dict[str, Any]:
+        """The blank's keyword arguments of a ``[pair]`` section."""
+        kw: dict[str, Any] = {
             "n1": int(p["n_pinion"]),
             "n2": int(p["n_gear"]),
             "module_mm": float(p["module_mm"]),
@@ -302,11 +305,16 @@ class SpiralBevelFamily:
             "pressure_angle_deg": float(p["pressure_angle_deg"]),
             "face_width_mm": float(p["face_width_mm"]),
         }
-        for k in ("shaft_angle_deg", "cutter_radius_mm", "edge_radius_mm"):
+        for k in self._optional:
             if k in p:
-                blank_kw[k] = float(p[k])
+                kw[k] = float(p[k])
         if p.get("hand", "right") != "right":
-            blank_kw["hand"] = p["hand"]
+            kw["hand"] = p["hand"]
+        return kw
+
+    def build(self, case: GearCase) -> GearPair:
+        p = case.pair
+        blank_kw = self.blank_kw(p)
         target_kw = {}
         if "te_amplitude_arcsec" in p:
             target_kw["te_amplitude_arcsec"] = float(p["te_amplitude_arcsec"])
@@ -319,38 +327,61 @@ class SpiralBevelFamily:
         )
         try:
             if key not in self._pairs:
-                self._pairs[key] = _bevel_pair(blank_kw, target_kw, machine)
+                self._pairs[key] = _bevel_pair(blank_kw, target_kw, machine, self.blank_type)
             sb = self._pairs[key]
         except InputError as exc:
             if exc.field.startswith("machine."):
                 raise
             raise _renamed(exc, None, self._fields, case) from exc
-        side = PAIR_SECTIONS["spiral_bevel"].value(p, "side")
+        side = PAIR_SECTIONS[self.kind].value(p, "side")
         return GearPair(sb.pinion, sb.gear, spiral_bevel_assembly(sb, side, case.errors), sb)
 
     def assemble(self, case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:
-        side = PAIR_SECTIONS["spiral_bevel"].value(case.pair, "side")
+        side = PAIR_SECTIONS[self.kind].value(case.pair, "side")
         return spiral_bevel_assembly(pair.spiral_bevel, side, errors)
 
 
-def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: dict | None = None):
-    """The bevel pair of the blank data, its settings synthesized (``machine`` None) or given
-    (``machine``: the flank tables of :mod:`fegear.geometry.bevel.sheet` as plain dicts, mm and
-    deg): read from the artefact cache when the same pair was built before by the same geometry
-    code (the synthesis takes 10-20 s, settings from tables about 8 s), else built and cached.
-    The entry is the pair's plain-data record
-    (:meth:`~fegear.geometry.bevel.SpiralBevelPair.record`, JSON: no pickle); the key
-    holds the code version of ``fegear.geometry`` and the numpy and scipy versions
-    (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis invalidates it."""
+class HypoidFamily(SpiralBevelFamily):
+    """Face-milled hypoid pair: the spiral bevel's pipeline on a hypoid blank (pitch cones of
+    ISO 23509 method 1, :class:`~fegear.geometry.bevel.HypoidBlank`), the gear axis offset
+    from the pinion axis by ``offset_mm``."""
+
+    kind = "hypoid"
+    blank_type = HypoidBlank
+    _fields = {**SpiralBevelFamily._fields, "offset_mm": "offset_mm"}
+    _optional = (
+        *SpiralBevelFamily._optional,
+        "offset_mm",
+        "pinion_face_width_mm",
+        "limit_pressure_angle_factor",
+    )
+
+
+def _bevel_pair(
+    blank_kw: dict[str, Any],
+    target_kw: dict[str, Any],
+    machine: dict | None = None,
+    blank_type: type = SpiralBevelBlank,
+):
+    """The bevel pair of the blank data (``blank_type(**blank_kw)``), its settings synthesized
+    (``machine`` None) or given (``machine``: the flank tables of
+    :mod:`fegear.geometry.bevel.sheet` as plain dicts, mm and deg): read from the artefact
+    cache when the same pair was built before by the same geometry code (the synthesis takes
+    10-20 s, settings from tables about 8 s), else built and cached. The entry is the pair's
+    plain-data record (:meth:`~fegear.geometry.bevel.SpiralBevelPair.record`, JSON: no pickle);
+    the key holds the blank kind, the code version of ``fegear.geometry`` and the numpy and
+    scipy versions (:data:`fegear.store.cache.PRODUCERS`), so a change of the synthesis
+    invalidates it."""
     if machine is None and blank_kw.get("hand", "right") == "left":
         # the mirror image of the right-hand pair (its synthesis cached under its own data)
-        right = _bevel_pair({k: v for k, v in blank_kw.items() if k != "hand"}, target_kw)
-        return right.mirrored(SpiralBevelBlank(**blank_kw))
+        right_kw = {k: v for k, v in blank_kw.items() if k != "hand"}
+        right = _bevel_pair(right_kw, target_kw, None, blank_type)
+        return right.mirrored(blank_type(**blank_kw))
     box: dict[str, Any] = {}
 
     def build(path: Path) -> None:
         # a design error raises here, before anything is written (nothing is cached)
-        blank = SpiralBevelBlank(**blank_kw)
+        blank = blank_type(**blank_kw)
         if machine is None:
             box["pair"] = SpiralBevelPair.design(blank, SynthesisTargets(**target_kw))
         else:
@@ -358,7 +389,9 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: di
             box["pair"] = SpiralBevelPair.from_settings(blank, settings_from_tables(blank, tables))
         path.write_text(json.dumps(box["pair"].record()), encoding="utf-8")
 
-    params = {"blank": blank_kw, "targets": target_kw}
+    params: dict[str, Any] = {"blank": blank_kw, "targets": target_kw}
+    if blank_type is not SpiralBevelBlank:  # the spiral bevel's keys as they always were
+        params["blank_kind"] = blank_type.field_prefix
     if machine is not None:
         params["machine"] = machine
     path, hit = cached_file("bevel_pair", params, ".json", build)
@@ -369,7 +402,14 @@ def _bevel_pair(blank_kw: dict[str, Any], target_kw: dict[str, Any], machine: di
 
 #: The gear families, by ``[case] kind``.
 FAMILIES: dict[str, Family] = {
-    f.kind: f for f in (FaceGearFamily(), SpurFamily(), CylindricalFamily(), SpiralBevelFamily())
+    f.kind: f
+    for f in (
+        FaceGearFamily(),
+        SpurFamily(),
+        CylindricalFamily(),
+        SpiralBevelFamily(),
+        HypoidFamily(),
+    )
 }
 
 

@@ -60,6 +60,7 @@ SHIFT_FLOOR_MM = 1e-3
 _MEASURE = {
     "face_gear": ("radius from the face-gear axis", "outer end", "inner end"),
     "spiral_bevel": ("distance from the apex", "outer end (heel)", "inner end (toe)"),
+    "hypoid": ("distance from the pinion apex", "outer end (heel)", "inner end (toe)"),
     "spur": ("axial position z from the face centre", "+z end", "-z end"),
 }
 
@@ -75,7 +76,7 @@ def _measure(kind: str, p: np.ndarray) -> np.ndarray:
     """``(n,)`` position along the face of contact points ``p`` ``(n, 3)`` (fixed frame, mm)."""
     if kind == "face_gear":
         return np.hypot(p[:, 0], p[:, 1])
-    if kind == "spiral_bevel":
+    if kind in ("spiral_bevel", "hypoid"):
         return np.linalg.norm(p, axis=1)
     return p[:, 2]
 

@@ -36,14 +36,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import DesignError, InputError
 
-__all__ = ["ARCSEC", "EDGE_RADIUS_MODULES", "SpiralBevelBlank"]
+__all__ = ["ARCSEC", "BevelBlank", "EDGE_RADIUS_MODULES", "SpiralBevelBlank"]
 
 Array = NDArray[np.float64]
 ARCSEC = math.pi / (180.0 * 3600.0)
@@ -319,3 +319,8 @@ class SpiralBevelBlank:
     def crossing_point(self) -> Array:
         """The point of the pinion axis nearest the gear axis: the common apex (origin)."""
         return np.zeros(3)
+
+
+#: A blank of either bevel kind: :class:`SpiralBevelBlank` or
+#: :class:`~.hypoid.HypoidBlank` (the same per-member protocol).
+BevelBlank = Any

@@ -52,7 +52,7 @@ from scipy.interpolate import CubicSpline
 from ...errors import DesignError, InputError, SolverError
 from ..generation import Envelope, generate
 from ..surface import BlankOutline, ConeLine, FlankBoundaries, FlankCoordinates, FlankSurface, Side
-from .blank import SpiralBevelBlank
+from .blank import BevelBlank
 from .cutter import EdgeRadius, blade_tip
 from .machine import MachineSettings, blank_placement, head_cutter, machine_motion, point_plane
 from .native import NativeFillet, NativeFlank, cone_coords
@@ -126,7 +126,7 @@ class SpiralBevelMember:
     name: str
     index: int
     n_teeth: int
-    blank: SpiralBevelBlank
+    blank: BevelBlank
     drive: MachineSettings
     coast: MachineSettings
     tol_mm: float = 1e-11

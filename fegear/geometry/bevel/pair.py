@@ -21,7 +21,8 @@ from ...errors import DesignError, InputError, SolverError
 from ..generation import generate
 from ..surface import Side
 from ..transforms import apply_points, apply_vectors
-from .blank import ARCSEC, SpiralBevelBlank
+from .blank import ARCSEC, BevelBlank, SpiralBevelBlank
+from .hypoid import HypoidBlank
 from .machine import MachineSettings, SpiralBevelSettings, mirrored
 from .member import SpiralBevelMember
 from .mesh_frame import mesh_transforms
@@ -65,7 +66,7 @@ class SpiralBevelPair:
     :meth:`from_settings` (no synthesis: ``reports`` is empty).
     """
 
-    blank: SpiralBevelBlank
+    blank: BevelBlank
     targets: SynthesisTargets
     settings: SpiralBevelSettings
     reports: dict[str, SynthesisReport]
@@ -76,7 +77,7 @@ class SpiralBevelPair:
     @classmethod
     def design(
         cls,
-        blank: SpiralBevelBlank | None = None,
+        blank: BevelBlank | None = None,
         targets: SynthesisTargets | None = None,
         settings: SpiralBevelSettings | None = None,
     ) -> SpiralBevelPair:
@@ -110,7 +111,7 @@ class SpiralBevelPair:
 
     @classmethod
     def from_settings(
-        cls, blank: SpiralBevelBlank, settings: SpiralBevelSettings, check: bool = True
+        cls, blank: BevelBlank, settings: SpiralBevelSettings, check: bool = True
     ) -> SpiralBevelPair:
         """The pair whose flanks the given machine settings cut (no synthesis): each member's
         flanks on the blank, the placement of each side found from the flanks' mean points
@@ -185,7 +186,8 @@ class SpiralBevelPair:
         without pickling code objects."""
         return {
             "format": _RECORD_FORMAT,
-            "blank": _plain_fields(self.blank),
+            "blank_kind": self.blank.field_prefix,
+            "blank": _blank_record(self.blank),
             "targets": _plain_fields(self.targets),
             "settings": {
                 k: _plain_fields(getattr(self.settings, k))
@@ -206,7 +208,7 @@ class SpiralBevelPair:
         """
         if rec.get("format") != _RECORD_FORMAT:
             raise InputError("spiral_bevel record format", rec.get("format"), _RECORD_FORMAT)
-        blank = SpiralBevelBlank(**rec["blank"])
+        blank = _blank_from_record(rec.get("blank_kind", "spiral_bevel"), rec["blank"])
         targets = SynthesisTargets(**rec["targets"])
         settings = SpiralBevelSettings(
             **{k: MachineSettings(**v) for k, v in rec["settings"].items()}
@@ -279,6 +281,22 @@ def flank_placement(
     n = apply_vectors(G, n_gear)
     sigma = float(np.sign(np.dot(np.cross(blank.pitch_point() - A2, n), e2)))
     return FlankPlacement(side, sigma, th2, d1)
+
+
+def _blank_record(blank) -> dict[str, Any]:
+    """A blank's input fields as plain data (a hypoid blank's own record)."""
+    if isinstance(blank, HypoidBlank):
+        return blank.record()
+    return _plain_fields(blank)
+
+
+def _blank_from_record(kind: str, rec: dict[str, Any]):
+    """The blank of :func:`_blank_record` (``kind``: the blank's ``field_prefix``)."""
+    if kind == HypoidBlank.field_prefix:
+        return HypoidBlank.from_record(rec)
+    if kind != SpiralBevelBlank.field_prefix:
+        raise InputError("bevel record blank_kind", kind, "'spiral_bevel' or 'hypoid'")
+    return SpiralBevelBlank(**rec)
 
 
 def _plain_fields(obj: Any) -> dict[str, Any]:
