@@ -4,9 +4,9 @@ A gear family is a :class:`Family`: it turns the ``[pair]`` table of a validated
 :class:`~fegear.io.gear_case.GearCase` into the generated members (objects of the
 :class:`~fegear.geometry.surface.GeneratedMember` protocol) and assembles them with installation
 errors. The pipeline reaches a family only through :data:`FAMILIES`, so a new family is one
-more :class:`Family` here (as the hypoid is: the spiral bevel's on another blank), its ``[pair]`` section in
-:mod:`fegear.io.gear_case` and its members in :mod:`fegear.geometry`; everything downstream of
-the pair (TCA, meshes, compliance, contact) works on the member protocol.
+more :class:`Family` here (as the hypoid is: the spiral bevel's on another blank), its
+``[pair]`` section in :mod:`fegear.io.gear_case` and its members in :mod:`fegear.geometry`;
+everything downstream of the pair (TCA, meshes, compliance, contact) works on the member protocol.
 """
 
 from __future__ import annotations
