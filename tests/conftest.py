@@ -64,3 +64,14 @@ def spiral_bevel_pair():
 
     case = load_case(Path(__file__).resolve().parents[1] / "cases" / "spiral_bevel_nominal.toml")
     return build_pair(case).spiral_bevel
+
+
+@pytest.fixture(scope="session")
+def hypoid_pair():
+    """The hypoid pair of ``cases/hypoid_nominal.toml`` as ``build_pair`` makes it (10/41,
+    offset 25 mm): one synthesis per process, shared with every hypoid case run in it."""
+    from fegear.case_files import load_case
+    from fegear.pipeline.pair import build_pair
+
+    case = load_case(Path(__file__).resolve().parents[1] / "cases" / "hypoid_nominal.toml")
+    return build_pair(case).spiral_bevel
