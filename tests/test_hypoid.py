@@ -265,3 +265,59 @@ def test_more_load_closes_more_pairs_and_spreads_the_pattern(loaded):
     assert ratio == sorted(ratio) and ratio[-1] > ratio[0], ratio
     # Hertz: a patch grows as F^(2/3), 7.4x for 20x the load; more pairs add theirs: at least 2x
     assert area == sorted(area) and area[-1] > 2.0 * area[0], area
+
+
+# --------------------------------------------------------------------------------------------
+# a hypoid from its summary sheet (cases/hypoid_sheet.toml: inches, degrees-minutes)
+# --------------------------------------------------------------------------------------------
+SHEET = (REPO / "cases" / "hypoid_sheet.toml").read_text(encoding="utf-8")
+
+
+def test_the_sheet_case_in_inches_has_the_nominal_unloaded_contact():
+    """cases/hypoid_sheet.toml holds the nominal pair's settings in inches and degrees-minutes
+    (``fegear settings cases/hypoid_nominal.toml --units in``): the rigid TCA of the nominal
+    case to the printed digits (9 decimals of an inch, 8 of an arc minute)."""
+    import fegear
+
+    nominal = fegear.run(load_case(REPO / "cases" / "hypoid_nominal.toml"), fidelity="tca")
+    sheet_case = load_case(REPO / "cases" / "hypoid_sheet.toml")
+    assert sheet_case.machine is not None and sheet_case.kind == "hypoid"
+    sheet = fegear.run(sheet_case, fidelity="tca")
+    # the TE is ~8″ from differences of µm: the printed digits move it by ~1e-6 of that
+    # (measured 8.098896 against 8.098894)
+    assert sheet.cycle.te_pp_unloaded_arcsec == pytest.approx(
+        nominal.cycle.te_pp_unloaded_arcsec, rel=1e-5
+    )
+    te_a = [p.te_unloaded_arcsec for p in nominal.positions]
+    te_b = [p.te_unloaded_arcsec for p in sheet.positions]
+    np.testing.assert_allclose(te_b, te_a, atol=1e-4)
+    assert sheet.checks.path_length_mm == pytest.approx(nominal.checks.path_length_mm, rel=1e-6)
+
+
+BAD = [
+    ("wrong_unit", ("radial_in = ", "radial_ft = "), ["machine.gear_drive.radial_ft"]),
+    ("missing_blade_angle", None, ["machine.pinion_drive.blade_angle", "required"]),
+    ("impossible_blade_angle", ('blade_angle_degmin = "21 03', 'blade_angle_degmin = "81 03'),
+     ["machine.gear_drive.blade_angle_degmin", "(0, 60)"]),
+    ("negative_offset", ("offset_mm = 25.0", "offset_mm = -25.0"), ["pair.offset_mm", ">= 0"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("edit", "words"), [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_a_bad_hypoid_sheet_is_refused_at_input_naming_the_field(tmp_path, capsys, edit, words):
+    from cli_checks import assert_refused
+
+    from fegear.cli import main
+
+    if edit is None:  # the pinion drive flank's blade angle line removed
+        start = SHEET.index("[machine.pinion_drive]")
+        line = SHEET[SHEET.index("blade_angle_degmin", start) :].split("\n")[0] + "\n"
+        text = SHEET[:start] + SHEET[start:].replace(line, "", 1)
+    else:
+        assert edit[0] in SHEET
+        text = SHEET.replace(edit[0], edit[1], 1)
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    code = main(["run", str(path), "--fidelity", "tca", "--out", str(tmp_path / "out")])
+    assert_refused(code, capsys.readouterr().err, words)
+    assert not (tmp_path / "out").exists()  # nothing written
