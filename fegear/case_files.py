@@ -1,9 +1,9 @@
 """Case files (TOML) of every kind: read one, dispatch on ``[case] kind``, and the case-file
 reference (``docs/case_files.md``).
 
-Gear pairs (``kind = "face_gear" | "spur" | "cylindrical" | "spiral_bevel"``) are validated by
-:mod:`fegear.io.gear_case` into a :class:`~fegear.io.gear_case.GearCase`; the Hertz scene
-(``kind = "hertz_scene"``) by :mod:`fegear.scenes.hertz_case` into a
+Gear pairs (``kind = "face_gear" | "spur" | "cylindrical" | "spiral_bevel" | "hypoid"``) are
+validated by :mod:`fegear.io.gear_case` into a :class:`~fegear.io.gear_case.GearCase`; the
+Hertz scene (``kind = "hertz_scene"``) by :mod:`fegear.scenes.hertz_case` into a
 :class:`~fegear.scenes.hertz_case.HertzCase`. Every problem raises
 :class:`~fegear.errors.InputError` naming the field, the value and what is allowed.
 """

@@ -5,8 +5,9 @@ results (summary.json, VTK + .pvd, PNG) into ``DIR`` (default ``./out``), one ru
 (:mod:`fegear.store.outputs`: an earlier run's files there are replaced, a folder with other
 files needs ``--overwrite``). The case kind decides what runs:
 
-- gear pairs (``face_gear``, ``spur``, ``spiral_bevel``): the loaded TCA (``--fidelity hybrid``,
-  the default, ``fe`` or ``hertz``) or the unloaded TCA (``--fidelity tca``);
+- gear pairs (``face_gear``, ``spur``, ``cylindrical``, ``spiral_bevel``, ``hypoid``): the loaded
+  TCA (``--fidelity hybrid``, the default, ``fe`` or ``hertz``) or the unloaded TCA
+  (``--fidelity tca``);
 - ``hertz_scene``: the FE Hertz check (``--fidelity fe | hybrid``, ``--study``, ``--backend``).
 
 With no CASE it runs the built-in seed face-gear case (``cases/face_gear_nominal.toml``: N2 160,

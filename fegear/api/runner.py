@@ -42,8 +42,8 @@ def load_case(path: str | Path) -> GearCase | HertzCase:
     Returns
     -------
     GearCase or HertzCase
-        A gear pair (``kind`` ``"face_gear"``, ``"spur"``, ``"spiral_bevel"``) or the Hertz
-        scene (``"hertz_scene"``).
+        A gear pair (``kind`` ``"face_gear"``, ``"spur"``, ``"cylindrical"``, ``"spiral_bevel"``,
+        ``"hypoid"``) or the Hertz scene (``"hertz_scene"``).
 
     Raises
     ------

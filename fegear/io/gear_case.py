@@ -80,6 +80,8 @@ def synthesis_keys(kind: str) -> tuple[str, ...]:
     """The :data:`SYNTHESIS_KEYS` of a bevel kind (a hypoid's blank needs its cutter radius:
     the limit condition of its pitch cones, :mod:`fegear.geometry.bevel.hypoid_cones`)."""
     return SYNTHESIS_KEYS if kind != "hypoid" else ("te_amplitude_arcsec",)
+
+
 #: Kinds with parallel axes (``[errors]``: centre distance and axis parallelism).
 PARALLEL_KINDS = ("spur", "cylindrical")
 #: Fidelities of the gear pairs (``docs/fidelity.md``).
@@ -264,8 +266,9 @@ def _bevel_keys(hypoid: bool) -> tuple[Key, ...]:
     )  # fmt: skip
     return (
         tuple(
-            Key(k.name, k.type, "pinion mean spiral angle, deg", True,
-                range=Range(0, 60, unit=_DEG))
+            Key(
+                k.name, k.type, "pinion mean spiral angle, deg", True, range=Range(0, 60, unit=_DEG)
+            )
             if k.name == "spiral_angle_deg"
             else k
             for k in keys
