@@ -1,7 +1,8 @@
 """The speed/accuracy trade of the fidelities on the gear scenes (issue 7).
 
-For the seed face gear (`cases/face_gear_nominal.toml`, 3e6 N·mm on the face gear) and the
-reference spiral bevel (`cases/spiral_bevel_nominal.toml`, 100 N·m on the pinion), each
+For the seed face gear (`cases/face_gear_nominal.toml`, 3e6 N·mm on the face gear), the
+reference spiral bevel (`cases/spiral_bevel_nominal.toml`, 100 N·m on the pinion) and the
+reference hypoid (`cases/hypoid_nominal.toml`, 100 N·m on the pinion), each
 ``FIDELITY:LEVEL`` runs the loaded cycle twice in fresh processes:
 
 * cold: an empty mesh/operator cache (sector meshes, compliance operators, positions);
@@ -41,6 +42,7 @@ ROOT = HERE.parent
 SCENES = {
     "face_gear": (ROOT / "cases" / "face_gear_nominal.toml", 25),
     "spiral_bevel": (ROOT / "cases" / "spiral_bevel_nominal.toml", 25),
+    "hypoid": (ROOT / "cases" / "hypoid_nominal.toml", 25),
 }
 CHILD = r"""
 import json, resource, sys, time
