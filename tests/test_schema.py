@@ -112,7 +112,7 @@ def test_the_bevel_edge_radius_reaches_the_synthesis(monkeypatch):
     replaced by a recorder here)."""
     seen = {}
 
-    def record(blank_kw, target_kw, machine=None):
+    def record(blank_kw, target_kw, machine=None, blank_type=None):
         seen.update(blank_kw)
         raise RuntimeError("recorded")
 
