@@ -240,6 +240,54 @@ def _patch_coordinates(centers: Array, normals: Array, edges: Array, origin: Arr
     return local - local.mean(axis=0)
 
 
+def grid_map(fm, uc: float, vc: float, coarse: Array, steps, angle: float) -> Array:
+    """``(2, 2)``: the map ``A`` from arc lengths ``(ξ, η)`` (mm) along the cell axes to flank
+    parameters, ``(u, v) = (uc, vc) + A (ξ, η)``, exact at ``(uc, vc)`` to first order.
+
+    With ``J = [r_u r_v]`` the flank's tangent vectors at ``(uc, vc)`` (central differences on
+    the exact flank map ``fm``), ``e_1 = r_u/|r_u|`` and ``e_2`` the unit vector of the tangent
+    plane normal to it on the ``r_v`` side, the cell axes are ``[e_1 e_2] R(angle)`` and
+
+        A = (Jᵀ J)⁻¹ Jᵀ [e_1 e_2] R(angle)
+
+    (the least-squares inverse of ``J``: exact in the tangent plane). Where ``u`` and ``v`` are
+    orthogonal arc-length-proportional coordinates this is ``diag(1/|r_u|, 1/|r_v|) R(angle)``.
+    Where they are not, a map from the mean lengths per unit ``u`` and ``v`` over the flank
+    turns the cells by another angle than ``angle`` and stretches them: on an involute helicoid
+    the length per unit of the roll parameter grows fourfold from root to tip and the ``u`` and
+    ``v`` lines are not orthogonal, and the turn that :func:`fegear.ltca.hybrid.refined_sizes`
+    measured on a patch was applied with a gain of two or more, so the grid of a contact line
+    100 mm long swung ±0.5 rad from one refinement to the next and never resolved the line
+    (ISO/TR 6336-30 example 1 with f_Hβ 10 µm: 19 of 25 positions degenerate).
+
+    ``coarse``: ``(nu, nv, 3)`` points of the coarse TCA grid (their spacing sets the
+    difference steps, ``steps``: the grid's parameter spacings ``(Δu, Δv)``).
+    """
+    b = fm.bounds
+    nu, nv = coarse.shape[:2]
+    du_c, dv_c = steps
+    lu = np.linalg.norm(coarse[1:] - coarse[:-1], axis=-1).mean() / du_c if nu > 1 else 1.0
+    lv = np.linalg.norm(coarse[:, 1:] - coarse[:, :-1], axis=-1).mean() / dv_c if nv > 1 else 1.0
+    # steps of about 1 µm, the stencil kept on the working flank
+    hu = min(1e-3 / lu, 0.25 * (b.u_tip - b.u_fillet))
+    hv = min(1e-3 / lv, 0.25 * (b.v_end - b.v_start))
+    u0 = min(max(uc, b.u_fillet + hu), b.u_tip - hu)
+    v0 = min(max(vc, b.v_start + hv), b.v_end - hv)
+    _, _, P, N = fm.native_point(
+        np.array([u0 + hu, u0 - hu, u0, u0, u0]), np.array([v0, v0, v0 + hv, v0 - hv, v0])
+    )
+    J = np.stack([(P[0] - P[1]) / (2.0 * hu), (P[2] - P[3]) / (2.0 * hv)], axis=1)
+    n = N[4] / np.linalg.norm(N[4])
+    e1 = J[:, 0] - (J[:, 0] @ n) * n
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    if e2 @ J[:, 1] < 0.0:
+        e2 = -e2
+    ca, sa = math.cos(angle), math.sin(angle)
+    E = np.stack([e1, e2], axis=1) @ np.array([[ca, -sa], [sa, ca]])
+    return np.linalg.solve(J.T @ J, J.T @ E)
+
+
 def near_cells(pos: PositionResult, grid_index: int, g_max: float) -> NDArray[np.bool_]:
     """``(nu, nv)`` bool: the coarse cells of the pair ``pos.grids[grid_index]`` whose region
     may hold a separation ``<= g_max``.
@@ -382,17 +430,12 @@ def pair_cells(
     b = tca.fm1.bounds
     nu, nv = g.valid.shape
     du_c, dv_c = g.u[1] - g.u[0], g.v[1] - g.v[0]
-    # Lengths (mm) per unit u and v from the coarse grid points.
-    P = g.points
-    lu = np.linalg.norm(P[1:, :, :] - P[:-1, :, :], axis=-1).mean() / du_c if nu > 1 else 1.0
-    lv = np.linalg.norm(P[:, 1:, :] - P[:, :-1, :], axis=-1).mean() / dv_c if nv > 1 else 1.0
-    # The cell grid: centres (u, v) = (uc, vc) + A (ξ, η), A = diag(1/lu, 1/lv) R(angle), with a
-    # centre on the pair's closest point, so that the discretisation is the same for every pair
-    # and position (no cell-phase jitter).
+    # The cell grid: centres (u, v) = (uc, vc) + A (ξ, η), with a centre on the pair's closest
+    # point, so that the discretisation is the same for every pair and position (no cell-phase
+    # jitter); A maps arc lengths along the turned axes to flank parameters (grid_map).
     ip = int(np.flatnonzero((pos.pairs[:, 0] == g.k) & (pos.pairs[:, 1] == g.j))[0])
     uc, vc = pos.pinion_uv[ip]
-    ca, sa = math.cos(angle), math.sin(angle)
-    A = np.array([[ca / lu, -sa / lu], [sa / lv, ca / lv]])
+    A = grid_map(tca.fm1, float(uc), float(vc), g.points, (du_c, dv_c), angle)
     Ainv = np.linalg.inv(A)
     # The coarse cells within g_max, dilated by one coarse cell, in (ξ, η).
     iu, iv = np.nonzero(near)
