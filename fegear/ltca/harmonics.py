@@ -12,8 +12,18 @@ the amplitude (half the peak-to-peak) of the ``k``-th mesh harmonic. A harmonic 
 ``n > 2k`` positions (Nyquist); the amplitudes of higher mesh orders present in the TE alias
 onto the lower ones when ``n`` is small (the coarse cycles of the tests: 9 positions resolve
 orders 1-4, and a TE with sharp handovers has content above), so a study of the harmonics takes
-``n_positions`` of 25 or more. A series with a position left out (lost contact, degenerate) has
-no uniform sampling: its amplitudes are None with the reason.
+``n_positions`` of 25 or more.
+
+A series with positions left out (lost contact, degenerate) is no longer uniformly sampled. Its
+harmonics are fitted by least squares on the ``m`` usable positions: the truncated Fourier
+series ``c_0 + Σ_{k=1}^{K} (a_k cos kω_i + b_k sin kω_i)``, ``A_k = √(a_k² + b_k²)``. On a
+full uniform cycle the Fourier columns are orthogonal and the fit returns the DFT's amplitudes
+exactly (any ``K < n/2``), so both paths agree where both apply. With gaps, the fit takes the
+largest ``K ≤ (n − 1)/2`` whose design matrix ``X`` keeps ``cond(X) ≤`` :data:`MAX_COND`
+(the orders above ``K`` leak into the fitted ones by at most about that factor times their own
+amplitude), and needs at least :data:`MIN_USABLE` of the cycle usable ("enough of the cycle"):
+one degenerate hand-over position out of 25 leaves 24, and the amplitudes are read from them,
+with ``positions_used`` saying so, instead of being dropped.
 """
 
 from __future__ import annotations
@@ -23,7 +33,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["MeshOrders", "mesh_orders"]
+__all__ = ["MAX_COND", "MIN_USABLE", "MeshOrders", "mesh_orders"]
+
+#: The least share of a cycle's positions that must be usable for its harmonics (module
+#: docstring); below it a gap spans more than a quarter of the mesh period and the higher
+#: orders are not determined by the positions left.
+MIN_USABLE = 0.75
+#: The largest condition number of the least-squares Fourier fit of a gappy series.
+MAX_COND = 10.0
 
 
 @dataclass(frozen=True)
@@ -43,12 +60,16 @@ class MeshOrders:
     orders: tuple[int, ...]
     amplitude_arcsec: tuple[float | None, ...]
     reason: str = ""
+    positions_used: int = 0
+    positions: int = 0
 
     def as_dict(self) -> dict[str, object]:
         return {
             "orders": list(self.orders),
             "amplitude_arcsec": list(self.amplitude_arcsec),
             "reason": self.reason,
+            "positions_used": self.positions_used,
+            "positions": self.positions,
         }
 
 
@@ -62,25 +83,49 @@ def mesh_orders(
     te_arcsec
         The TE at the ``n`` positions of the cycle (arcsec).
     usable
-        ``(n,)`` bool, the positions whose TE is a TE (default: all); with any False every
-        amplitude is None.
+        ``(n,)`` bool, the positions whose TE is a TE (default: all); the others are left out
+        and the amplitudes fitted on the rest (module docstring).
     n_orders
         How many mesh orders (1 … n_orders).
     """
     te = np.asarray(te_arcsec, dtype=float)
     orders = tuple(range(1, n_orders + 1))
     n = te.size
-    if usable is not None and not np.all(usable):
-        bad = int(np.sum(~np.asarray(usable, dtype=bool)))
-        why = f"{bad} of {n} positions left out (lost or degenerate): no uniform sampling"
-        return MeshOrders(orders, (None,) * n_orders, why)
-    if n == 0 or not np.all(np.isfinite(te)):
-        return MeshOrders(orders, (None,) * n_orders, "no finite TE series")
-    spec = np.fft.rfft(te)
-    amps: list[float | None] = []
-    for k in orders:
-        amps.append(float(2.0 * abs(spec[k]) / n) if n > 2 * k else None)
+    ok = np.ones(n, bool) if usable is None else np.asarray(usable, dtype=bool).copy()
+    ok &= np.isfinite(te)
+    m = int(ok.sum())
+    if m == 0:
+        return MeshOrders(orders, (None,) * n_orders, "no finite TE series", 0, n)
+    if m == n:
+        spec = np.fft.rfft(te)
+        amps: list[float | None] = []
+        for k in orders:
+            amps.append(float(2.0 * abs(spec[k]) / n) if n > 2 * k else None)
+        why = "" if all(a is not None for a in amps) else (
+            f"{n} positions resolve mesh orders below {n / 2:g} only (n > 2k)"
+        )  # fmt: skip
+        return MeshOrders(orders, tuple(amps), why, n, n)
+    left = f"{n - m} of {n} positions left out (lost or degenerate)"
+    if m < MIN_USABLE * n:
+        why = f"{left}: fewer than {100 * MIN_USABLE:g} % of the cycle usable"
+        return MeshOrders(orders, (None,) * n_orders, why, m, n)
+    w = 2.0 * np.pi * np.flatnonzero(ok) / n
+    fit = None
+    for K in range((n - 1) // 2, 0, -1):
+        if 2 * K + 1 > m:
+            continue
+        k = np.arange(1, K + 1)
+        X = np.hstack([np.ones((m, 1)), np.cos(np.outer(w, k)), np.sin(np.outer(w, k))])
+        if np.linalg.cond(X) <= MAX_COND:
+            coef = np.linalg.lstsq(X, te[ok], rcond=None)[0]
+            fit = (K, np.hypot(coef[1 : K + 1], coef[K + 1 :]))
+            break
+    if fit is None:
+        why = f"{left}: no well-conditioned Fourier fit (cond > {MAX_COND:g})"
+        return MeshOrders(orders, (None,) * n_orders, why, m, n)
+    K, amp = fit
+    amps = [float(amp[k - 1]) if k <= K else None for k in orders]
     why = "" if all(a is not None for a in amps) else (
-        f"{n} positions resolve mesh orders below {n / 2:g} only (n > 2k)"
+        f"{left}: the positions left determine mesh orders up to {K} only (cond ≤ {MAX_COND:g})"
     )  # fmt: skip
-    return MeshOrders(orders, tuple(amps), why)
+    return MeshOrders(orders, tuple(amps), why, m, n)

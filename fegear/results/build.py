@@ -83,6 +83,22 @@ def _checks(run: GearRun) -> Checks | None:
             "path_ends": (cp.start_limit, cp.end_limit),
             "path_pinion_angles_deg": (math.degrees(cp.phi_start), math.degrees(cp.phi_end)),
         }
+        open_ends = [
+            name
+            for name, limit in (("start", cp.start_limit), ("end", cp.end_limit))
+            if limit.startswith("unresolved")
+        ]
+        if open_ends:
+            # the interval runs past the pairs the cycle's TCA followed: its length is the part
+            # seen, not the pair's contact (a helical pair of overlap ratio near 1 and more)
+            path.update(
+                contact_ratio_unloaded=None,
+                path_length_mm=None,
+                path_length_in_space_mm=None,
+                path_reason=f"the contact interval's {' and '.join(open_ends)} "
+                "reaches past the pairs the TCA followed (path_ends: unresolved): the contact "
+                "ratio and the path length of the part seen would understate them",
+            )
     return Checks(
         pinion_tip_clearance_mm=None if cl is None else _f(cl.pinion_tip_mm),
         gear_tip_clearance_mm=None if cl is None else _f(cl.gear_tip_mm),
