@@ -4,9 +4,11 @@ headlines of the result model (:class:`fegear.results.GearRunResult`), never rec
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from fegear.output.figure import pyplot as _plt
 from fegear.output.figure import run_title as _title
@@ -18,20 +20,72 @@ from fegear.results.model import GearRunResult
 from fegear.store.files import atomic_write
 from fegear.tca.plots import plot_te
 
-__all__ = ["loaded_plots", "tca_plots"]
+__all__ = ["TESeries", "loaded_plots", "per_pair", "tca_plots", "te_series"]
+
+Array = NDArray[np.float64]
 
 
 def _num(x: float | None, fmt: str) -> str:
     return "not reported" if x is None else format(x, fmt)
 
 
+@dataclass(frozen=True)
+class TESeries:
+    """What ``te.png`` draws.
+
+    Attributes
+    ----------
+    phi1_deg
+        ``(n,)`` pinion angles of the positions (deg).
+    unloaded
+        ``(n,)`` arcsec, the unloaded TE (NaN where the TCA found no contact: a placeholder).
+    loaded
+        ``(n,)`` arcsec, the loaded TE of the usable positions (NaN at those left out).
+    left_out
+        ``{status: (m,) position indices}`` of the positions left out of the loaded TE
+        (``"degenerate"``, ``"lost"``).
+    left_out_te
+        ``(n,)`` arcsec, the loaded TE as the cycle holds it at every position (where the
+        left-out positions are marked).
+    """
+
+    phi1_deg: Array
+    unloaded: Array
+    loaded: Array
+    left_out: dict[str, NDArray[np.int_]]
+    left_out_te: Array
+
+
+def te_series(cycle) -> TESeries:
+    """The :class:`TESeries` of a :class:`~fegear.ltca.results.LoadedCycle`."""
+    pos = cycle.positions
+    ok = np.array([p.status == "ok" for p in pos], dtype=bool)
+    seen = np.array([p.unloaded_contact for p in pos], dtype=bool)
+    te_l = np.asarray(cycle.te_loaded_arcsec, dtype=float)
+    te_u = np.asarray(cycle.te_unloaded_arcsec, dtype=float)
+    status = sorted({p.status for p in pos} - {"ok"})
+    left = {s: np.array([i for i, p in enumerate(pos) if p.status == s], dtype=int) for s in status}
+    return TESeries(
+        np.degrees(np.asarray(cycle.phi1, dtype=float)),
+        np.where(seen, te_u, np.nan),
+        np.where(ok, te_l, np.nan),
+        left,
+        te_l,
+    )
+
+
 def _plot_te(out: Path, run: GearRun, result: GearRunResult) -> Path:
+    """``te.png``: the unloaded and the loaded TE (gaps where a position has none); the
+    positions left out of the loaded TE (lost, degenerate) as open markers at the value the
+    cycle holds there."""
     plt = _plt()
-    c = run.cycle
-    deg = np.degrees(c.phi1)
+    s = te_series(run.cycle)
     fig, ax = plt.subplots(figsize=(6.5, 4))
-    ax.plot(deg, c.te_unloaded_arcsec, "o-", ms=3, label="unloaded")
-    ax.plot(deg, c.te_loaded_arcsec, "s-", ms=3, label="loaded")
+    ax.plot(s.phi1_deg, s.unloaded, "o-", ms=3, label="unloaded")
+    ax.plot(s.phi1_deg, s.loaded, "s-", ms=3, label="loaded")
+    for (status, idx), m in zip(s.left_out.items(), "DvX", strict=False):
+        ax.plot(s.phi1_deg[idx], s.left_out_te[idx], m, ms=7, mfc="none", mec="tab:red",
+                mew=1.2, ls="none", label=f"left out: {status} ({idx.size})")  # fmt: skip
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("TE (arcsec)")
     h = result.cycle
@@ -46,12 +100,12 @@ def _plot_te(out: Path, run: GearRun, result: GearRunResult) -> Path:
     return _save(fig, out / "te.png")
 
 
-def _per_pair(run: GearRun, attr: str) -> dict[int, np.ndarray]:
-    """``{pinion tooth: (n,) values}`` (NaN where the pair is not modelled or not loaded)."""
-    c = run.cycle
-    teeth = sorted({q.k for p in c.positions for q in p.pairs})
-    out = {k: np.full(len(c.positions), np.nan) for k in teeth}
-    for i, p in enumerate(c.positions):
+def per_pair(cycle, attr: str) -> dict[int, Array]:
+    """``{pinion tooth: (n,) values of attr}`` of the loaded pairs of ``cycle`` (NaN where the
+    pair is not modelled or carries no load: out of contact)."""
+    teeth = sorted({q.k for p in cycle.positions for q in p.pairs})
+    out = {k: np.full(len(cycle.positions), np.nan) for k in teeth}
+    for i, p in enumerate(cycle.positions):
         for q in p.pairs:
             if q.force_N > 0:
                 out[q.k][i] = getattr(q, attr)
@@ -59,16 +113,19 @@ def _per_pair(run: GearRun, attr: str) -> dict[int, np.ndarray]:
 
 
 def _plot_load_share(out: Path, run: GearRun, result: GearRunResult) -> Path:
+    """``load_share.png``: each pair's share of the torque where it is in contact (a gap where
+    it is not: its curve starts and ends where its contact does)."""
     plt = _plt()
     deg = np.degrees(run.cycle.phi1)
     fig, ax = plt.subplots(figsize=(6.5, 4))
-    for k, v in _per_pair(run, "load_share").items():
-        ax.plot(deg, np.nan_to_num(v), "o-", ms=3, label=f"pinion tooth {k:+d}")
+    for k, v in per_pair(run.cycle, "load_share").items():
+        ax.plot(deg, v, "o-", ms=3, label=f"pinion tooth {k:+d}")
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("load share (torque fraction)")
     ax.set_ylim(-0.05, 1.05)
     cr = result.cycle.contact_ratio_loaded
-    ax.set_title(f"{_title(run)}\nloaded contact ratio {_num(cr, '.2f')}", fontsize=9)
+    ax.set_title(f"{_title(run)}\nloaded contact ratio {_num(cr, '.2f')}; each pair drawn "
+                 "where it carries load", fontsize=9)  # fmt: skip
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _save(fig, out / "load_share.png")

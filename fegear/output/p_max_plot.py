@@ -7,7 +7,8 @@ away from the edges (:attr:`fegear.ltca.results.PairContact.p_interior_MPa`) and
 "position max" line, the largest of them at each position (a gap where a position has no
 interior value); the edge values (:attr:`~fegear.ltca.results.PairContact.p_edge_MPa`) are separate
 markers, "singular". The y range is that of the interior values; an edge value above it is drawn
-at the top edge of the plot as an upward triangle with its value written beside it.
+at the top edge of the plot as an upward triangle, the largest of them with their values written
+under them, as many as fit without overlapping (:func:`label_picks`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["PMaxSeries", "p_max_series", "plot_p_max", "save_p_max"]
+__all__ = ["PMaxSeries", "label_picks", "p_max_series", "plot_p_max", "save_p_max"]
 
 Array = NDArray[np.float64]
 
@@ -96,13 +97,41 @@ def plot_p_max(ax, series: PMaxSeries) -> tuple[float, float] | None:
         if above.size:
             y = 0.97 * top
             ax.plot(above[:, 0], np.full(len(above), y), "r^", ms=6,
-                    label="at a flank edge, above the range (value beside; singular)")  # fmt: skip
-            for x, v in zip(above[:, 0], above[:, 1], strict=True):
-                ax.annotate(f"{v:.0f}", (x, y), textcoords="offset points", xytext=(0, -11),
-                            ha="center", fontsize=6, color="r")  # fmt: skip
+                    label=f"at a flank edge, above the range ({len(above)}; singular): "
+                    "the largest values written")  # fmt: skip
+            _edge_labels(ax, above[:, 0], above[:, 1], y)
     if ylim is not None:
         ax.set_ylim(*ylim)
     return ylim
+
+
+def label_picks(x: Array, values: Array, min_dx: float) -> NDArray[np.int_]:
+    """Indices of the values to write beside their markers at abscissae ``x`` so that no two
+    labels are closer than ``min_dx`` (their width): the largest first, then each next largest
+    that keeps clear of those chosen (greedy). Sorted by ``x``."""
+    chosen: list[int] = []
+    for i in np.argsort(-np.asarray(values, dtype=float), kind="stable"):
+        if all(abs(x[i] - x[j]) >= min_dx for j in chosen):
+            chosen.append(int(i))
+    return np.array(sorted(chosen, key=lambda i: x[i]), dtype=int)
+
+
+def _label_width(ax, n_chars: int, fontsize: float) -> float:
+    """The width of a label of ``n_chars`` digits at ``fontsize`` in the x units of ``ax``
+    (about 0.6 em a digit, and an em of room between labels)."""
+    fig = ax.get_figure()
+    axes_pt = ax.get_position().width * fig.get_figwidth() * 72.0
+    lo, hi = ax.get_xlim()
+    return (0.6 * n_chars + 1.0) * fontsize / axes_pt * abs(hi - lo)
+
+
+def _edge_labels(ax, x: Array, values: Array, y: float, fontsize: float = 6.0) -> None:
+    """Write the edge values ``values`` above the range under their markers at ``(x, y)``, as
+    many as fit side by side, the largest first (:func:`label_picks`)."""
+    width = _label_width(ax, len(f"{float(np.max(values)):.0f}"), fontsize)
+    for i in label_picks(x, values, width):
+        ax.annotate(f"{values[i]:.0f}", (x[i], y), textcoords="offset points", xytext=(0, -11),
+                    ha="center", fontsize=fontsize, color="r")  # fmt: skip
 
 
 def save_p_max(path: Path, cycle, title: str, save) -> Path:

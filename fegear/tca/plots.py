@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .ellipse import outline
 from .results import CycleResult
+
+Array = NDArray[np.float64]
+#: the dash of a line contact's contact line (:func:`draw_ellipses`)
+LINE_STYLE = (0, (4, 2))
 
 __all__ = [
     "plot_te",
@@ -17,6 +23,11 @@ __all__ = [
     "plot_assembly_conventions",
     "flank_outline",
     "draw_ellipses",
+    "Drawn",
+    "contact_kind",
+    "contact_line",
+    "clip_to_box",
+    "legend_entries",
     "axis_label",
 ]
 
@@ -130,6 +141,74 @@ def axis_label(text: str, width: int = 42) -> str:
     return "\n".join(textwrap.wrap(text, width)) or text
 
 
+@dataclass(frozen=True)
+class Drawn:
+    """What :func:`draw_ellipses` drew: ``ellipses`` outlines, ``lines`` contact-line segments
+    (line contacts, :func:`contact_kind`)."""
+
+    ellipses: int
+    lines: int
+
+    def __bool__(self) -> bool:
+        return self.ellipses + self.lines > 0
+
+
+def _extent(bounds) -> Array:
+    """``(2,)`` the flank's coordinate extent ``(u_tip − u_fillet, v_end − v_start)``."""
+    return np.array([bounds.u_tip - bounds.u_fillet, bounds.v_end - bounds.v_start], dtype=float)
+
+
+def contact_kind(e, member: str, which: str, bounds=None) -> str:
+    """``"point"``, ``"line"`` or ``"none"``: how the ellipse ``which`` (``"paint"`` or
+    ``"hertz"``) of :class:`~fegear.tca.ellipse.EllipseAt` ``e`` is to be drawn on ``member``'s
+    flank.
+
+    A line contact (``e.line_contact``) has no ellipse; an ellipse whose outline spans more of
+    either flank coordinate than the flank has (``bounds``: its
+    :class:`~fegear.geometry.surface.FlankBoundaries`) is a line contact too: the flank cannot
+    hold it, its contact is the line the flank cuts from the major axis. ``"none"``: no ellipse
+    of that kind (e.g. no Hertz ellipse without a load) and no line to draw.
+    """
+    if e.line_contact:
+        return "line"
+    o = outline(e, member, which)
+    if o is None:
+        return "none"
+    if bounds is not None and np.any(np.ptp(o, axis=0) > _extent(bounds)):
+        return "line"
+    return "point"
+
+
+def clip_to_box(p0: Array, d: Array, lo: Array, hi: Array) -> Array | None:
+    """``(2, 2)`` the segment of the line ``p0 + t d`` inside the box ``[lo, hi]`` (2-D;
+    Liang-Barsky), or None when the line misses it."""
+    t0, t1 = -np.inf, np.inf
+    for k in range(2):
+        if abs(d[k]) < 1e-300:
+            if not lo[k] <= p0[k] <= hi[k]:
+                return None
+            continue
+        a, b = sorted(((lo[k] - p0[k]) / d[k], (hi[k] - p0[k]) / d[k]))
+        t0, t1 = max(t0, a), min(t1, b)
+    if not t0 < t1:
+        return None
+    return np.array([p0 + t0 * d, p0 + t1 * d])
+
+
+def contact_line(e, member: str, bounds) -> Array | None:
+    """``(2, 2)`` flank coordinates ``(u, v)`` of the contact line of a line contact: the major
+    axis through the contact point, taken to the flank through its tangents (first order) and
+    clipped to the flank's ``[u_fillet, u_tip] × [v_start, v_end]`` (None: it misses it)."""
+    c = e.curvature
+    T, uv0 = (
+        (c.pinion_tangents, e.pinion_uv) if member == "pinion" else (c.gear_tangents, e.gear_uv)
+    )
+    d = np.linalg.lstsq(T, c.major_axis, rcond=None)[0]
+    lo = np.array([bounds.u_fillet, bounds.v_start], dtype=float)
+    hi = np.array([bounds.u_tip, bounds.v_end], dtype=float)
+    return clip_to_box(np.asarray(uv0, dtype=float), d, lo, hi)
+
+
 def draw_ellipses(
     ax,
     ellipses,
@@ -138,28 +217,50 @@ def draw_ellipses(
     xy=None,
     color: str = "tab:blue",
     lw: float = 0.6,
-) -> int:
+    bounds=None,
+    lines: bool = True,
+) -> Drawn:
     """Draw the contact ellipses of a TCA path (:func:`fegear.tca.ellipse.ellipses`) on a flank.
 
     ``member``: whose flank coordinates; ``which``: ``"paint"`` (Litvin's instantaneous ellipse,
     solid) and/or ``"hertz"`` (one pair carrying the whole load, dashed); ``xy(uv (n, 2)) ->
-    (x (n,), y (n,))`` the plot coordinates of flank coordinates (default ``(v, u)``). Returns the
-    number of outlines drawn (line contacts have none).
+    (x (n,), y (n,))`` the plot coordinates of flank coordinates (default ``(v, u)``).
+    ``bounds`` (the flank's boundaries): a line contact (:func:`contact_kind`: none, or an
+    ellipse longer than the flank) is drawn as its contact line clipped to the flank (dashed,
+    twice as wide), once per position (``lines`` False: not drawn); without ``bounds`` line
+    contacts are left out. Returns the :class:`Drawn` counts.
     """
     xy = xy or (lambda uv: (uv[:, 1], uv[:, 0]))
     styles = {"paint": "-", "hertz": "--"}
-    n = 0
+    n = n_lines = 0
     for e in ellipses:
         if e is None:
             continue
+        line = False
         for w in which:
-            o = outline(e, member, w)
-            if o is None:
-                continue
-            x, y = xy(o)
-            ax.plot(x, y, styles[w], color=color, lw=lw)
-            n += 1
-    return n
+            kind = contact_kind(e, member, w, bounds)
+            if kind == "point":
+                x, y = xy(outline(e, member, w))
+                ax.plot(x, y, styles[w], color=color, lw=lw)
+                n += 1
+            line |= kind == "line"
+        seg = contact_line(e, member, bounds) if line and lines and bounds is not None else None
+        if seg is not None:
+            x, y = xy(seg)
+            ax.plot(x, y, ls=LINE_STYLE, color=color, lw=2 * lw)
+            n_lines += 1
+    return Drawn(n, n_lines)
+
+
+def legend_entries(ax, drawn: Drawn, which: str, color: str, label: str, lw: float) -> None:
+    """Legend entries for what :func:`draw_ellipses` drew: ``label`` for the ellipses (``which``
+    their style), and "line contact" for the contact lines, with their counts."""
+    if drawn.ellipses:
+        ax.plot([], [], "-" if which == "paint" else "--", color=color, lw=lw, label=label)
+    if drawn.lines:
+        ax.plot([], [], ls=LINE_STYLE, color=color, lw=2 * lw,
+                label=f"line contact at {drawn.lines} positions (ellipse longer than the "
+                "flank): contact line, no ellipse")  # fmt: skip
 
 
 def plot_pattern(
@@ -177,13 +278,13 @@ def plot_pattern(
         ax.pcolormesh(V, U, r.pattern_pinion.astype(float), cmap="Greys", vmin=0, vmax=1.5)
     m = r.has_contact
     ax.plot(r.pinion_uv[m, 1], r.pinion_uv[m, 0], "r.-", ms=3, label="contact path")
-    if ellipses is not None and draw_ellipses(ax, ellipses, "pinion", ("paint",), lw=0.5):
-        ax.plot([], [], "-", color="tab:blue", lw=0.5,
-                label=f"ellipse, paint {1e3 * r.paint_mm:.2f} µm")  # fmt: skip
-        if draw_ellipses(ax, ellipses, "pinion", ("hertz",), color="tab:green", lw=0.5):
-            T1 = next(e.pinion_torque_Nm for e in ellipses if e is not None)
-            ax.plot([], [], "--", color="tab:green", lw=0.5,
-                    label=f"Hertz, one pair at {T1:.4g} N·m")  # fmt: skip
+    if ellipses is not None:
+        T1 = next((e.pinion_torque_Nm for e in ellipses if e is not None), 0.0)
+        d = draw_ellipses(ax, ellipses, "pinion", ("paint",), lw=0.5, bounds=bounds)
+        legend_entries(ax, d, "paint", "tab:blue", f"ellipse, paint {1e3 * r.paint_mm:.2f} µm", 0.5)
+        d = draw_ellipses(ax, ellipses, "pinion", ("hertz",), "tab:green", 0.5, bounds, False)
+        legend_entries(ax, d, "hertz", "tab:green",
+                       f"Hertz, one pair at {T1:.4g} N·m", 0.5)  # fmt: skip
     if bounds is not None:
         ax.set_xlim(bounds.v_start, bounds.v_end)
         ax.set_ylim(bounds.u_fillet, bounds.u_tip)
