@@ -89,7 +89,8 @@ def _ellipse(a_mm: float, b_mm: float, line_contact: bool = False, uv=(10.0, 0.0
     c = NS(pinion_tangents=T, gear_tangents=T, major_axis=major, minor_axis=minor)
     hz = None if line_contact else NS(a_mm=a_mm, b_mm=b_mm)
     return NS(curvature=c, pinion_uv=np.array(uv), gear_uv=np.array(uv), hertz=hz,
-              line_contact=line_contact, paint_a_mm=None, paint_b_mm=b_mm)  # fmt: skip
+              line_contact=line_contact, paint_a_mm=None, paint_b_mm=b_mm,
+              pinion_torque_Nm=100.0)  # fmt: skip
 
 
 def test_an_ellipse_longer_than_the_flank_is_a_line_contact():
@@ -293,3 +294,27 @@ def test_ripple_is_peak_to_peak_over_the_mean():
     assert pct == pytest.approx(100.0 / 24.0, rel=1e-12)
     assert cylindrical_output.ripple(np.array([np.nan])) is None
     assert cylindrical_output.stiffness_limits(np.array([24.5, 23.0]))[0] == 0.0
+
+
+def test_unloaded_pattern_names_line_contacts_and_keeps_point_ellipses(tmp_path, monkeypatch):
+    """Fidelity ``tca``'s picture: a spur pair's positions (line contacts) give contact lines
+    and a legend entry saying so, no ellipse; a crowned pair's give the paint and the Hertz
+    ellipses."""
+    from fegear.tca.plots import plot_pattern
+
+    r = NS(pattern_pinion=np.zeros(0), has_contact=np.ones(3, dtype=bool),
+           pinion_uv=np.array([[10.0, 0.0]] * 3), paint_mm=0.00632)  # fmt: skip
+    bounds = NS(**vars(_BOUNDS), u_name="u (mm)", v_name="v (mm)")
+    figs = []
+    monkeypatch.setattr(plt.Figure, "savefig", lambda fig, *a, **k: figs.append(fig))
+    plot_pattern(r, tmp_path / "a.png", bounds, ellipses=[_ellipse(0.0, 0.2, True)] * 3)
+    point = _ellipse(5.0, 1.0)
+    point.paint_a_mm = 8.0
+    plot_pattern(r, tmp_path / "b.png", bounds, ellipses=[point] * 3)
+    line_labels = figs[0].axes[0].get_legend_handles_labels()[1]
+    point_labels = figs[1].axes[0].get_legend_handles_labels()[1]
+    assert any(t.startswith("line contact at 3 positions") for t in line_labels)
+    assert not any(t.startswith(("ellipse", "Hertz")) for t in line_labels)
+    assert any(t.startswith("ellipse, paint") for t in point_labels)
+    assert any(t.startswith("Hertz") for t in point_labels)
+    assert not any(t.startswith("line contact") for t in point_labels)

@@ -50,7 +50,7 @@ def _face_panel(ax, fig, ld, run) -> None:
         if pos.force_N > 0:
             ax.step(ld.z_mm, pos.q_N_per_mm / qm, where="mid", lw=0.7, alpha=0.7,
                     color=cmap(norm(i)), ls="-" if pos.usable else ":")  # fmt: skip
-    if ld.k_h_beta is not None:
+    if ld.k_h_beta is not None and ld.q_mean_N_per_mm is not None:
         ax.step(ld.z_mm, ld.q_mean_N_per_mm / qm, where="mid", lw=2.2, color="k",
                 label=f"cycle mean: KHβ = {ld.k_h_beta:.3f}")  # fmt: skip
     if any(p.force_N > 0 and not p.usable for p in ld.positions):
@@ -82,6 +82,7 @@ def _stiffness_panel(ax, ld, run) -> None:
     if ld.c_gamma is not None:
         ax.axhline(ld.c_gamma, color="k", lw=1.2, label=f"c_γ = {ld.c_gamma:.2f}")
     r = ripple(c)
+    log.debug("line_load: c_γ ripple %s, left out %s", r, sorted(set(status) - {"ok"}))
     ax.set_ylim(lo, hi)
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("mesh stiffness c_γ(φ) (N/(mm·µm))")

@@ -1,12 +1,17 @@
 """The bearing-pattern picture of a gear run, ``bearing_pattern.png`` (pinion flank).
 
 Loaded fidelities (:func:`plot_loaded_pattern`): the union of the loaded contact cells coloured
-by the largest pressure over the cycle, the force centroids, and the unloaded TCA path with the
-Hertz ellipse of one pair carrying the whole load at each contact point. Fidelity ``tca``
-(:func:`plot_unloaded_pattern`): the cells within the paint thickness, the path, and at each
-contact point Litvin's instantaneous ellipse for the paint thickness and the Hertz ellipse
+by the largest pressure over the cycle on a scale that ends at the largest pressure away from
+the flank edges (:func:`colour_scale`; the singular, grid-dependent edge values never set it:
+the cells on a flank edge are hatched, their largest value is in the legend, the colours above
+the scale are clipped and the colour bar says so), the force centroids, and the unloaded TCA
+path with the Hertz ellipse of one pair carrying the whole load at each contact point. Fidelity
+``tca`` (:func:`plot_unloaded_pattern`): the cells within the paint thickness, the path, and at
+each contact point Litvin's instantaneous ellipse for the paint thickness and the Hertz ellipse
 (:func:`fegear.tca.plots.plot_pattern`). The ellipses are those of ``summary.json``
-(``positions[i].contact_ellipse``, :mod:`fegear.tca.ellipse`).
+(``positions[i].contact_ellipse``, :mod:`fegear.tca.ellipse`); an ellipse the flank cannot hold
+(longer than the flank: a spur or helical pair without crowning) is a line contact, drawn as its
+contact line clipped to the flank (:func:`fegear.tca.plots.contact_kind`).
 """
 
 from __future__ import annotations
@@ -159,6 +164,8 @@ def plot_loaded_pattern(out: Path, run: GearRun) -> Path:
     P_in, P_edge, path = _painted(run, us, vs)
     P = np.maximum(P_in, P_edge)
     scale = colour_scale(run.cycle.positions)
+    log.debug("bearing pattern: colour scale to %s MPa, edge cells up to %s MPa",
+              scale.vmax, scale.edge_max)  # fmt: skip
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     im = ax.pcolormesh(vs, us, np.ma.masked_where(P <= 0, P), cmap="inferno", shading="nearest",
                        vmin=0.0, vmax=scale.vmax)  # fmt: skip

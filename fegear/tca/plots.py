@@ -282,7 +282,8 @@ def plot_pattern(
         T1 = next((e.pinion_torque_Nm for e in ellipses if e is not None), 0.0)
         d = draw_ellipses(ax, ellipses, "pinion", ("paint",), lw=0.5, bounds=bounds)
         legend_entries(ax, d, "paint", "tab:blue", f"ellipse, paint {1e3 * r.paint_mm:.2f} µm", 0.5)
-        d = draw_ellipses(ax, ellipses, "pinion", ("hertz",), "tab:green", 0.5, bounds, False)
+        d = draw_ellipses(ax, ellipses, "pinion", ("hertz",), color="tab:green", lw=0.5,
+                          bounds=bounds, lines=False)  # fmt: skip
         legend_entries(ax, d, "hertz", "tab:green",
                        f"Hertz, one pair at {T1:.4g} N·m", 0.5)  # fmt: skip
     if bounds is not None:
