@@ -75,14 +75,15 @@ def te_series(cycle) -> TESeries:
 
 
 def _plot_te(out: Path, run: GearRun, result: GearRunResult) -> Path:
-    """``te.png``: the unloaded and the loaded TE (gaps where a position has none); the
-    positions left out of the loaded TE (lost, degenerate) as open markers at the value the
-    cycle holds there."""
+    """``te.png``: the unloaded TE (a gap where the TCA found no contact) and the loaded TE of
+    the usable positions, the headline's; the positions left out of it (lost, degenerate) as
+    open markers at the value the cycle holds there."""
     plt = _plt()
     s = te_series(run.cycle)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.plot(s.phi1_deg, s.unloaded, "o-", ms=3, label="unloaded")
-    ax.plot(s.phi1_deg, s.loaded, "s-", ms=3, label="loaded")
+    ok = np.isfinite(s.loaded)  # the line joins the usable positions (the headline's)
+    ax.plot(s.phi1_deg[ok], s.loaded[ok], "s-", ms=3, label="loaded (usable positions)")
     for (status, idx), m in zip(s.left_out.items(), "DvX", strict=False):
         ax.plot(s.phi1_deg[idx], s.left_out_te[idx], m, ms=7, mfc="none", mec="tab:red",
                 mew=1.2, ls="none", label=f"left out: {status} ({idx.size})")  # fmt: skip
