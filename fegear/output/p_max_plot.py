@@ -141,11 +141,12 @@ def save_p_max(path: Path, cycle, title: str, save) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.5, 4))
+    fig, ax = plt.subplots(figsize=(7, 5))
     plot_p_max(ax, p_max_series(cycle))
     ax.set_xlabel("pinion angle φ1 (deg)")
     ax.set_ylabel("largest cell pressure (MPa)")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    # below the axes: inside, it hides the markers (edge values) where it stands
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
     return save(fig, path)
