@@ -317,32 +317,46 @@ def test_handover_of_a_conjugate_pair_is_its_contact_ratio():
         assert abs(h.interior_fraction - expected) < 2e-4, (da, h.interior_fraction, expected)
 
 
-def test_degenerate_positions_are_flagged_and_left_out_of_the_te(tmp_path, capsys):
-    """FZG at hybrid with a 0.5 mm out-of-plane axis error: at two positions both pairs sit on
-    one 2 mm cell (220-950 MPa next to 14-17 GPa, the TE 130-200″ off): they are flagged
-    degenerate, named on the terminal and left out of the TE p-p (7 of 9 used). Every other
-    contact is a corner contact at a face end or the gear tip: p_max is null with the reason,
-    the edge value beside it, and no "0 MPa" is printed."""
+def test_corner_contacts_under_a_large_axis_error_are_resolved(tmp_path, capsys):
+    """FZG at hybrid with a 0.5 mm out-of-plane axis error: every contact is a corner contact
+    at a face end or the gear tip. The cells are turned onto each patch and fitted to the face
+    ends, so every position is resolved (6-19 cells across each patch; none degenerate, all 9
+    in the TE p-p). p_max is null with the reason (all contacts at a flank edge), the edge value
+    beside it, and no "0 MPa" is printed."""
     path = _fzg(tmp_path, "f_sigma_beta_mm = 0.0 ", "f_sigma_beta_mm = 0.5 ")
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out)]) == 0
     err = capsys.readouterr().err
-    assert "warning: degenerate (a loaded patch the cells do not resolve) at 2 of 9" in err
-    assert "0 (φ1 = -11.250°), 5 (φ1 = 1.250°)" in err
+    assert "degenerate" not in err
     assert "warning: p_max not reported: every loaded contact is at a flank edge" in err
     assert " 0 MPa" not in err
-    doc = _summary(out)
-    c = doc["cycle"]
-    assert [(e["index"], e["status"]) for e in c["excluded_positions"]] == [
-        (0, "degenerate"),
-        (5, "degenerate"),
-    ]
-    assert "on 1 cell" in c["excluded_positions"][0]["reason"]
-    assert c["te_pp_loaded_positions_used"] == 7
-    te = [p["te_loaded_arcsec"] for i, p in enumerate(doc["positions"]) if i not in (0, 5)]
-    assert c["te_pp_loaded_arcsec"] == pytest.approx(max(te) - min(te), rel=1e-12)
+    c = _summary(out)["cycle"]
+    assert c["excluded_positions"] == [] and c["te_pp_loaded_positions_used"] == 9
     assert c["p_max_MPa"] is None and "flank edge" in c["p_max_reason"]
     assert c["p_max_edge_MPa"] > 1e4 and c["p_max_edge_at"]["edges"]
+
+
+def test_degenerate_positions_are_flagged_and_left_out_of_the_te(tmp_path, capsys):
+    """The same pair with ``[contact] max_cells = 30``: the cap makes the cells of a pair 0.18 x
+    0.35 mm where 0.03 x 0.06 mm were asked, 2 or fewer across a 0.36 mm patch at 6 positions:
+    the run says the option made the cells coarser than asked, flags those positions
+    degenerate, names them on the terminal and leaves them out of the TE p-p (3 of 9 used)."""
+    path = _fzg(tmp_path, "f_sigma_beta_mm = 0.0 ", "f_sigma_beta_mm = 0.5 ")
+    path.write_text(path.read_text(encoding="utf-8") + "\n[contact]\nmax_cells = 30\n")
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "warning: contact cells coarser than asked at" in err and "max_cells = 30" in err
+    assert "warning: degenerate (a loaded patch the cells do not resolve) at 6 of 9" in err
+    assert "0 (φ1 = -11.250°), 4 (φ1 = -1.250°)" in err
+    doc = _summary(out)
+    c = doc["cycle"]
+    left = [e["index"] for e in c["excluded_positions"] if e["status"] == "degenerate"]
+    assert left == [0, 4, 5, 6, 7, 8]
+    assert "across its patch" in c["excluded_positions"][0]["reason"]
+    assert c["te_pp_loaded_positions_used"] == 3
+    te = [p["te_loaded_arcsec"] for i, p in enumerate(doc["positions"]) if i not in left]
+    assert c["te_pp_loaded_arcsec"] == pytest.approx(max(te) - min(te), rel=1e-12)
 
 
 # --------------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.transforms import apply_points, apply_vectors, compose
+from fegear.ltca.cell_fit import fit_to_boundaries
 from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
@@ -481,9 +482,38 @@ def pair_cells(
         cu_mm, cv_mm = cu_mm * f, cv_mm * f
     if not keep.any():
         return None
+
+    def on_at(xi: Array, eta: Array) -> NDArray[np.bool_]:
+        """Grid points on both working flanks (the pinion's, and the gear's hit)."""
+        u = uc + A[0, 0] * xi + A[0, 1] * eta
+        v = vc + A[1, 0] * xi + A[1, 1] * eta
+        res = (u >= b.u_fillet) & (u <= b.u_tip) & (v >= b.v_start) & (v <= b.v_end)
+        if res.any():
+            res[res] = separation_at(tca, pos.phi1, -pos.te_rad, i, u[res], v[res])[4]
+        return res
+
+    # The cells' edges, the outer ones on the flank boundaries (fegear.ltca.cell_fit).
+    lo_e, hi_e = fit_to_boundaries(on_at, XI, ETA, inside & ok, keep, (cu_mm, cv_mm))
+    mid, size = 0.5 * (lo_e + hi_e), hi_e - lo_e
+    moved = np.any(np.abs(mid - np.stack([XI[keep], ETA[keep]], -1)) > 1e-12, axis=1)
+    Xk, Nk, sk, hk = X[keep], N[keep], s[keep], h[keep]
+    CUk = uc + A[0, 0] * mid[:, 0] + A[0, 1] * mid[:, 1]
+    CVk = vc + A[1, 0] * mid[:, 0] + A[1, 1] * mid[:, 1]
+    if moved.any():
+        Xm, Nm, sm, hm, okm, _ = separation_at(
+            tca, pos.phi1, -pos.te_rad, i, CUk[moved], CVk[moved]
+        )
+        # (a fitted centre lies between the kept centre and its boundary: on both flanks)
+        take = np.flatnonzero(moved)[okm]
+        Xk[take], Nk[take], sk[take], hk[take] = Xm[okm], Nm[okm], sm[okm], hm[okm]
+        back = np.flatnonzero(moved)[~okm]
+        mid[back] = np.stack([XI[keep], ETA[keep]], -1)[back]
+        size[back] = (cu_mm, cv_mm)
+        CUk[back], CVk[back] = CU[keep][back], CV[keep][back]
     # 2 x 2 Gauss points of the kept cells (exact pinion flank, fixed frame).
-    gx = XI[keep][:, None, None] + 0.5 * cu_mm * _GAUSS2[None, :, None]
-    gy = ETA[keep][:, None, None] + 0.5 * cv_mm * _GAUSS2[None, None, :]
+    su, sv = size[:, 0], size[:, 1]
+    gx = mid[:, 0][:, None, None] + 0.5 * su[:, None, None] * _GAUSS2[None, :, None]
+    gy = mid[:, 1][:, None, None] + 0.5 * sv[:, None, None] * _GAUSS2[None, None, :]
     gx, gy = np.broadcast_arrays(gx, gy)
     gu = uc + A[0, 0] * gx + A[0, 1] * gy
     gv = vc + A[1, 0] * gx + A[1, 1] * gy
@@ -492,22 +522,22 @@ def pair_cells(
     quad = apply_points(Mk, Pq).reshape(-1, 4, 3)
     # Areas from the Gauss points: |r_ξ x r_η| dξ dη by central differences of the 2x2 points.
     q = quad.reshape(-1, 2, 2, 3)
-    rx = (q[:, 1, :, :] - q[:, 0, :, :]).mean(axis=1) / (cu_mm / math.sqrt(3.0))
-    ry = (q[:, :, 1, :] - q[:, :, 0, :]).mean(axis=1) / (cv_mm / math.sqrt(3.0))
-    area = np.linalg.norm(np.cross(rx, ry), axis=-1) * cu_mm * cv_mm
-    edges = np.stack([rx * cu_mm, ry * cv_mm], axis=1)
-    local = _patch_coordinates(X[keep], N[keep], edges, np.asarray(pos.points[ip], dtype=float))
+    rx = (q[:, 1, :, :] - q[:, 0, :, :]).mean(axis=1) / (su[:, None] / math.sqrt(3.0))
+    ry = (q[:, :, 1, :] - q[:, :, 0, :]).mean(axis=1) / (sv[:, None] / math.sqrt(3.0))
+    area = np.linalg.norm(np.cross(rx, ry), axis=-1) * su * sv
+    edges = np.stack([rx * su[:, None], ry * sv[:, None]], axis=1)
+    local = _patch_coordinates(Xk, Nk, edges, np.asarray(pos.points[ip], dtype=float))
     du, dv = cu_mm, cv_mm  # cell sizes along ξ, η (mm)
     mask = _boundary_mask(CU, CV, A, (du, dv), inside, ok, guv, b, tca.fm2.bounds)
     return PairCells(
         k=int(g.k),
         j=int(g.j),
-        uv=np.stack([CU[keep], CV[keep]], -1),
-        centers=X[keep],
-        normals=N[keep],
+        uv=np.stack([CUk, CVk], -1),
+        centers=Xk,
+        normals=Nk,
         quad_points=quad,
-        gap=s[keep],
-        h=h[keep],
+        gap=sk,
+        h=hk,
         area=area,
         local=local,
         edges=edges,

@@ -82,6 +82,15 @@ def _no_contact(pos: PositionResult, reason: str) -> LoadedPosition:
     return LoadedPosition.lost(pos.phi1, pos.te_arcsec, bool(pos.has_contact), reason)
 
 
+#: The start of a position's warning that ``max_cells`` made a pair's cells coarser than asked.
+CAPPED = "max_cells:"
+#: A pair's cells at least this many times the area asked are reported (:data:`CAPPED`): within
+#: it the cells across a patch are fewer by under √2, inside the margin the refinement aims
+#: with (``n_across / 1.25`` cells: :func:`fegear.ltca.hybrid.refined_sizes`); the default
+#: ``max_cells`` caps the line contacts of FZG by 1.2-1.4 in area.
+CAP_AREA_RATIO = 2.0
+
+
 def _excluded_violation(pos: PositionResult, g_max: float, theta: float) -> bool:
     """Could a point left out (separation above ``g_max``) close under the lag ``θ``? Only if
     its rigid gap ``g − θ h`` is negative (the elastic term ``C F`` opens it further). Tested
@@ -247,6 +256,16 @@ def solve_position(
         if sol2 is None or _excluded_violation(pos, g_ref, sol2.theta):
             break
         cells, sol, g_max, cell, h_max = cells2, sol2, g_ref, sizes, h2
+    cap = models.kind.max_cells(models)
+    for c in cells:
+        asked = cell.get((c.k, c.j), cell[None])
+        if c.cell_mm[0] * c.cell_mm[1] > CAP_AREA_RATIO * asked[0] * asked[1]:
+            warnings.append(
+                f"{CAPPED} pair ({c.k}, {c.j}) at phi1 = {np.degrees(pos.phi1):.3f} deg: cells "
+                f"of {c.cell_mm[0]:.3g} x {c.cell_mm[1]:.3g} mm where {asked[0]:.3g} x "
+                f"{asked[1]:.3g} mm were asked: the pair's zone holds more than max_cells = "
+                f"{cap} of them"
+            )
     for k, j in missing_pairs(pos, cells, g_max, modelled):
         ip = int(np.flatnonzero((pos.pairs[:, 0] == k) & (pos.pairs[:, 1] == j))[0])
         warnings.append(

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from fegear.ltca.position import CAPPED
 from fegear.ltca.validity import ValidityCheck, validity_checks
 from fegear.pipeline.run import GearRun
 from fegear.results.cylindrical import cylindrical_section, te_harmonics
@@ -152,6 +153,14 @@ def _loaded_warnings(run: GearRun, h, te_l, te_l_why, missed: bool) -> list[str]
                 f"of {n} positions: the pressures and the TE there are cell averages, not the "
                 "contact's; run --fidelity hybrid (it resolves the patch at every level)"
             )
+    capped = [i for i, p in enumerate(c.positions) if any(w.startswith(CAPPED) for w in p.warnings)]
+    if capped:
+        cap = next(w for w in c.positions[capped[0]].warnings if w.startswith(CAPPED))
+        warnings.append(
+            f"contact cells coarser than asked at {len(capped)} of {n} positions ([contact] "
+            f"max_cells caps the cells of one pair; e.g. {cap.removeprefix(CAPPED).strip()}): "
+            "raise max_cells, or leave max_cells and cell_mm to their defaults"
+        )
     if degen:
         where = (
             f"all {n} positions"
