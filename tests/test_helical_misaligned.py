@@ -135,3 +135,27 @@ def test_no_usable_position_gives_no_distribution(runs):
     d = load_distribution(r.pair.pinion, r.pair.gear, r.assembly, cycle).as_dict()
     assert d["q_mean_N_per_mm"] is None and d["k_h_beta"] is None
     assert d["c_gamma_N_per_mm_um"] is None and "no usable position" in d["reason"]
+
+
+def test_the_path_of_a_helical_line_contact_does_not_depend_on_the_positions():
+    """The example with a 40 mm face (ε_β 0.44: the interval's ends resolved by the three pairs
+    the TCA follows): the path is the mid-face section's, an arc length between the flank
+    limits, the same from 9 and 25 positions; the contact interval ends where the line's last
+    part leaves the working profiles (gear tip, pinion tip) at any sampling, its ratio to the
+    bisection's resolution."""
+    case = fegear.load_case(CASE)
+    case = case.replace(pair={**case.pair, "face_width_mm": 40.0})
+    cy = {
+        n: fegear.run(case.replace(n_positions=n), fidelity="tca").summary["cycle"] for n in (9, 25)
+    }
+    # the fits' round-off moves the ends (measured 2.4e-7 mm of 14.5 mm)
+    assert cy[9]["path_length_mm"] == pytest.approx(cy[25]["path_length_mm"], rel=1e-6)
+    assert cy[9]["path_length_in_space_mm"] == pytest.approx(
+        cy[25]["path_length_in_space_mm"], rel=1e-6
+    )
+    for c in cy.values():
+        assert c["path_ends"] == ["gear:tip", "pinion:tip"], c["path_ends"]
+    # both ends bisected to cycle / (9 · 9⁴) from the coarser sampling
+    assert cy[9]["contact_ratio_unloaded"] == pytest.approx(
+        cy[25]["contact_ratio_unloaded"], abs=2.0 / (9 * 9**4)
+    )

@@ -17,7 +17,8 @@ localized one runs along it under misalignment; it stays flagged as an edge cont
   over with their working surfaces,
 - the path: pair 0's contact points on the gear (member 2) flank, in the gear frame, over the
   interval; its length is the polyline length through the samples and the two ends (a line
-  contact is traced at mid-face: its points lie anywhere along the line),
+  contact's path is its mid-face section's, whose length is an arc length independent of the
+  samples: :mod:`fegear.tca.line_path`),
 - what ends the interval at each end: the edge the pair runs onto (``"gear:tip"``,
   ``"pinion:tip"``, ...) or ``"transfer"`` when another pair takes the contact over first.
 """
@@ -34,6 +35,7 @@ from fegear.store.cache import cached_file
 from ..geometry.transforms import apply_points
 from .cached import pair_key
 from .core import TCA
+from .line_path import line_contact_states, mid_face_path
 from .parallel import positions as parallel_positions
 from .results import PositionResult
 
@@ -115,9 +117,27 @@ def _samples(tca: TCA, pos: PositionResult, tol_rad: float) -> list[_Sample]:
     return out
 
 
-def _evaluate(tca: TCA, psi: Array, tol_rad: float, workers: int | None) -> list[_Sample]:
+def _as_line(tca: TCA, samples: list[_Sample], tol_rad: float) -> list[_Sample]:
+    """The samples of a line contact, in contact by the line's sections and not by the TCA's
+    point (:func:`fegear.tca.line_path.line_contact_states`)."""
+    if not samples:
+        return samples
+    psi = np.array([x.psi for x in samples])
+    uv1 = np.array([x.uv1 for x in samples])
+    inside, edge = line_contact_states(tca, psi, uv1, tol_rad)
+    out = []
+    for x, ok, e in zip(samples, inside, edge, strict=True):
+        tied = x.edge != "transfer"  # pair 0 closes first (another pair has not taken over)
+        out.append(_Sample(x.psi, tied and bool(ok), e if tied else "transfer", x.uv1, x.uv2))
+    return out
+
+
+def _evaluate(
+    tca: TCA, psi: Array, tol_rad: float, workers: int | None, line: bool = False
+) -> list[_Sample]:
     """Pair-0 samples at angles ``psi`` (each solved at ``φ1`` in the central cycle, all pairs;
-    in up to ``workers`` processes: :func:`fegear.tca.parallel.positions`)."""
+    in up to ``workers`` processes: :func:`fegear.tca.parallel.positions`); ``line``: of a line
+    contact (:func:`_as_line`)."""
     tau = 2 * np.pi / tca.asm.n1
     m_of = -tca.asm.sense1 * tca.pairs[:, 0]
     shift = np.round(np.asarray(psi) / tau)
@@ -128,7 +148,7 @@ def _evaluate(tca: TCA, psi: Array, tol_rad: float, workers: int | None) -> list
     for p, s in zip(done, shift, strict=True):
         i = int(np.flatnonzero(m_of == s)[0])
         out.append(_samples(tca, p, tol_rad)[i])
-    return out
+    return _as_line(tca, out, tol_rad) if line else out
 
 
 def _refine(
@@ -137,6 +157,7 @@ def _refine(
     tol_rad: float,
     rounds: int,
     workers: int | None,
+    line: bool = False,
 ) -> list[tuple[_Sample, _Sample]]:
     """Brackets ``(a, b)`` (``a`` inside, ``b`` outside) shrunk by batched bisection, 8 inner
     points per bracket and round, the points of all brackets in one batch of positions (each
@@ -144,7 +165,7 @@ def _refine(
     brackets = list(brackets)
     for _ in range(rounds):
         psi = [np.linspace(a.psi, b.psi, 10)[1:-1] for a, b in brackets]
-        flat = _evaluate(tca, np.concatenate(psi), tol_rad, workers) if psi else []
+        flat = _evaluate(tca, np.concatenate(psi), tol_rad, workers, line) if psi else []
         for j, (a, b) in enumerate(brackets):
             s = flat[8 * j : 8 * j + 8]
             ins = [x.inside for x in s]
@@ -178,6 +199,9 @@ def contact_path(
     ContactPath, or None if pair 0 is never in interior contact.
     """
     s = sorted((x for p in positions for x in _samples(tca, p, tol_rad)), key=lambda x: x.psi)
+    line = any(p.ellipse is not None and p.ellipse.line_contact for p in positions)
+    if line:
+        s = _as_line(tca, s, tol_rad)
     inside = np.array([x.inside for x in s])
     if not inside.any():
         return None
@@ -194,7 +218,7 @@ def contact_path(
     ends = ([(s[lo], s[lo - 1])] if lo > 0 else []) + (
         [(s[hi], s[hi + 1])] if hi < len(s) - 1 else []
     )
-    refined = _refine(tca, ends, tol_rad, rounds, workers)
+    refined = _refine(tca, ends, tol_rad, rounds, workers, line)
     start_limit = end_limit = "unresolved (the interval reaches past the cycle's pairs)"
     if lo > 0:
         start, before = refined.pop(0)
@@ -207,22 +231,27 @@ def contact_path(
     phi = np.array([x.psi for x in run])
     uv1 = np.array([x.uv1 for x in run])
     uv2 = np.array([x.uv2 for x in run])
-    if any(p.ellipse is not None and p.ellipse.line_contact for p in positions):
-        # a line contact (conjugate spur pair) touches along the whole face: the TCA's point on
-        # it is its centre only where the tie is resolved; the path is the one at mid-face
-        b1 = tca.fm1.bounds
-        shift = 0.5 * (b1.v_start + b1.v_end) - uv1[:, 1]
-        uv1[:, 1] += shift
-        uv2[:, 1] += shift  # parallel axes: the face coordinates are axial positions of both
+    phi_start, phi_end = float(phi[0]), float(phi[-1])
+    mid = None
+    if line:
+        # a line contact touches along a line across the face: the TCA's point is anywhere on
+        # it; the path is the mid-face section's (fegear.tca.line_path)
+        mid = mid_face_path(tca, phi, uv1, tol_rad)
+        if mid is not None:
+            phi, uv1, uv2 = mid.phi, mid.pinion_uv, mid.gear_uv
     g = tca.fm2.evaluate(*tca.fm2.native(uv2[:, 0], uv2[:, 1]))[0]
     p = tca.fm1.evaluate(*tca.fm1.native(uv1[:, 0], uv1[:, 1]))[0]
-    length = float(np.linalg.norm(np.diff(g, axis=0), axis=1).sum())
+    length = (
+        mid.length_mm
+        if mid is not None
+        else float(np.linalg.norm(np.diff(g, axis=0), axis=1).sum())
+    )
     fixed = apply_points(tca.asm.placement1(phi), p)
     tau = 2 * np.pi / tca.asm.n1
     return ContactPath(
-        phi_start=float(phi[0]),
-        phi_end=float(phi[-1]),
-        contact_ratio=float((phi[-1] - phi[0]) / tau),
+        phi_start=phi_start,
+        phi_end=phi_end,
+        contact_ratio=float((phi_end - phi_start) / tau),
         length_mm=length,
         phi=phi,
         gear_points=g,
