@@ -120,7 +120,8 @@ def measure(section: str) -> list[Row]:
 
         rows = [as_row(d) for d in _run_part("cyl:ratios")]
         runs = [
-            C.StiffnessRun(**_run_part(f"cyl:stiffness:{n}")) for n in ("helical_15", "helical_25")
+            C.StiffnessRun(**_run_part(f"cyl:stiffness:{n}"))
+            for n in ("helical_15", "helical_25", "iso_tr_ex1")
         ]
         rows += C.stiffness_rows(runs)
         rows += C.hertz_rows(C.HertzRun(**_run_part("cyl:hertz")))

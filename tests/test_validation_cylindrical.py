@@ -49,7 +49,7 @@ def test_helical_line_hertz_row():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["helical_15", "helical_25"])
+@pytest.mark.parametrize("name", ["helical_15", "helical_25", "iso_tr_ex1"])
 def test_helical_stiffness_rows(name):
     s = C.stiffness_run(name)
     rows = {r.key.rsplit("_", 1)[-1]: r for r in C.stiffness_rows([s])}
