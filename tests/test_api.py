@@ -389,6 +389,17 @@ def test_fzg_run_writes_the_summary_keys(fzg_run):
     assert summary_value(doc, "cycle.p_max_edge_MPa") == (max(edge) if edge else None)
 
 
+def test_the_default_spur_run_reports_its_te_harmonics():
+    """cases/fzg_spur.toml as shipped (9 positions; the sectors of the runs above): every
+    position resolved, so the first three mesh orders of the loaded TE are read from all 9
+    (orders up to 4 fit below Nyquist); a hand-over corner left out would have nulled them all."""
+    r = fegear.run(fegear.load_case(FZG), fields=False)
+    h = r.summary["cycle"]["te_harmonics"]["loaded"]
+    assert [p.status for p in r.positions] == ["ok"] * 9
+    assert all(a is not None and a > 0 for a in h["amplitude_arcsec"]), h
+    assert h["positions_used"] == h["positions"] == 9 and h["reason"] == ""
+
+
 def test_fzg_pvd_reads_back_with_pyvista(fzg_run):
     import pyvista as pv
 
