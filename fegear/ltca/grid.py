@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.transforms import apply_points, apply_vectors, compose
-from fegear.ltca.cell_fit import fit_to_boundaries
+from fegear.ltca.cell_fit import MIN_FITTED, fit_to_boundaries
 from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
@@ -494,6 +494,14 @@ def pair_cells(
 
     # The cells' edges, the outer ones on the flank boundaries (fegear.ltca.cell_fit).
     lo_e, hi_e = fit_to_boundaries(on_at, XI, ETA, inside & ok, keep, (cu_mm, cv_mm))
+    whole = (hi_e - lo_e)[:, 1] >= MIN_FITTED * cv_mm  # slivers dropped (cell_fit)
+    if not whole.any():
+        return None
+    if not whole.all():
+        flat = np.flatnonzero(keep.ravel())
+        keep = keep.copy()
+        keep.ravel()[flat[~whole]] = False
+        lo_e, hi_e = lo_e[whole], hi_e[whole]
     mid, size = 0.5 * (lo_e + hi_e), hi_e - lo_e
     moved = np.any(np.abs(mid - np.stack([XI[keep], ETA[keep]], -1)) > 1e-12, axis=1)
     Xk, Nk, sk, hk = X[keep], N[keep], s[keep], h[keep]
