@@ -84,6 +84,15 @@ HANDOVER_FRACTION = 2.0 / (48 * 8**3)
 #: amplification measured on the cases: up to 2.4e-5 relative (FZG edge pressure, another
 #: machine; 4.3e-7 between one and two BLAS threads)
 LOADED_RTOL = 1e-4
+#: a line-load bin without load (N/mm): the forces' round-off, up to 1.5e-6 N/mm measured
+#: between two processes on ISO/TR 6336-30 example 1, against loads of 100-800 N/mm
+LINE_LOAD_ATOL = 1e-4
+#: the semi-axes (mm) and cells across of a patch of one loaded cell: 0 to round-off (4.5e-10 mm
+#: measured between two processes)
+PATCH_ATOL = 1e-6
+#: a loaded-TE mesh order near zero (arcsec): LOADED_RTOL of a lag of some 10-100″ spread over
+#: the orders
+HARMONIC_ATOL_ARCSEC = 1e-3
 
 #: the TCA's contact ellipses: the principal curvatures are central second differences of the
 #: exact flanks (``fegear.tca.ellipse.contact_curvature``), accurate to 3e-3 of the relative
@@ -119,6 +128,16 @@ TOLERANCES: list[tuple[re.Pattern[str], float, float, str]] = [
          "an orientation of the curvature tensor, to ELLIPSE_RTOL rad"),
         (r"\.contact_ellipses?\.", ELLIPSE_RTOL, ELLIPSE_ATOL,
          "finite-difference curvatures and what is made of them, to ELLIPSE_RTOL of B"),
+        (r"^\.cylindrical\.load\.", LOADED_RTOL, LINE_LOAD_ATOL,
+         "line loads, KHβ and stiffnesses of the loaded cycle's forces, to LOADED_RTOL; a bin "
+         "without load reads the forces' round-off: LINE_LOAD_ATOL"),
+        (r"^\.cycle\.te_harmonics\.loaded\.", LOADED_RTOL, HARMONIC_ATOL_ARCSEC,
+         "the loaded TE's mesh orders: its positions' values to LOADED_RTOL through a DFT or "
+         "fit; an order near zero to HARMONIC_ATOL_ARCSEC"),
+        (r"\.(semi_m[a-z]+_mm|cells_across_patch)$", LOADED_RTOL, PATCH_ATOL,
+         "a patch's axes, to LOADED_RTOL; a patch of one cell measures 0 to round-off"),
+        (r"^\.validity\.checks\[\d+\]\.value$", LOADED_RTOL, ATOL,
+         "the validity checks read the loaded cycle's approach and p_max"),
         (r"^\.(positions\[\d+\]\.pairs\[\d+\]\.contact_point_mm|cycle\.path_|pattern\.)",
          0.0, LOCATION_MM,
          "the TCA's contact points, located to LOCATION_MM, and what is measured from them (the "
