@@ -19,8 +19,10 @@ on the flank, so its area is that of the flank part whatever the boundary's angl
 (a straight boundary: the trapezoid and the rectangle of equal midline have equal areas). Cells
 whose neighbours are on the flank are left as they are: the zone's limit at ``g_max`` is not a
 boundary. A cell left with less than :data:`MIN_FITTED` of its length (a sliver between a tip
-and a face end, where the grid crosses a corner) is dropped: its pressure would be a force over
-a vanishing area (FZG with a 0.03 mm axis tilt: a 0.00016 mm cell read 989 GPa).
+and a face end, where the grid crosses a corner) keeps its grid cell: fitted, its pressure
+would be a force over a vanishing area (FZG with a 0.03 mm axis tilt: a 0.00016 mm cell read
+989 GPa), and dropped, the corner contact it stands for is lost (the spiral bevel's third pair
+entering at 400 N·m took no load).
 
 Only along ``η``: the grid's ``η`` runs along the contact line of a line contact and along the
 major axis of a patch (:func:`fegear.ltca.hybrid.refined_sizes` turns it so), where the gap
@@ -42,9 +44,8 @@ __all__ = ["BISECTIONS", "MIN_FITTED", "fit_to_boundaries"]
 Array = NDArray[np.float64]
 #: Halvings of the bisection for a boundary crossing (to ``2⁻¹²`` of a cell).
 BISECTIONS = 12
-#: The shortest fitted cell kept, in units of the grid's cell length along ``η``: a shorter one
-#: is a sliver (module docstring); the strip it covered, under a quarter of a cell, carries
-#: nothing, as the strips between the last centres and a boundary did before cells were fitted.
+#: The shortest fitted cell, in units of the grid's cell length along ``η``: a shorter one is a
+#: sliver and keeps its grid cell (module docstring).
 MIN_FITTED = 0.25
 
 

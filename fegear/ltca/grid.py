@@ -494,14 +494,11 @@ def pair_cells(
 
     # The cells' edges, the outer ones on the flank boundaries (fegear.ltca.cell_fit).
     lo_e, hi_e = fit_to_boundaries(on_at, XI, ETA, inside & ok, keep, (cu_mm, cv_mm))
-    whole = (hi_e - lo_e)[:, 1] >= MIN_FITTED * cv_mm  # slivers dropped (cell_fit)
-    if not whole.any():
-        return None
-    if not whole.all():
-        flat = np.flatnonzero(keep.ravel())
-        keep = keep.copy()
-        keep.ravel()[flat[~whole]] = False
-        lo_e, hi_e = lo_e[whole], hi_e[whole]
+    sliver = (hi_e - lo_e)[:, 1] < MIN_FITTED * cv_mm  # keeps its grid cell (cell_fit)
+    if sliver.any():
+        c0 = np.stack([XI[keep], ETA[keep]], -1)[sliver]
+        lo_e[sliver] = c0 - 0.5 * np.array([cu_mm, cv_mm])
+        hi_e[sliver] = c0 + 0.5 * np.array([cu_mm, cv_mm])
     mid, size = 0.5 * (lo_e + hi_e), hi_e - lo_e
     moved = np.any(np.abs(mid - np.stack([XI[keep], ETA[keep]], -1)) > 1e-12, axis=1)
     Xk, Nk, sk, hk = X[keep], N[keep], s[keep], h[keep]
