@@ -39,7 +39,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BISECTIONS", "MIN_FITTED", "fit_to_boundaries"]
+__all__ = ["BISECTIONS", "MIN_FITTED", "fit_to_boundaries", "neighbour_values"]
 
 Array = NDArray[np.float64]
 #: Halvings of the bisection for a boundary crossing (to ``2⁻¹²`` of a cell).
@@ -49,7 +49,7 @@ BISECTIONS = 12
 MIN_FITTED = 0.25
 
 
-def _neighbour_on(on: NDArray[np.bool_], axis: int, step: int, outside) -> NDArray[np.bool_]:
+def neighbour_values(on: NDArray[np.bool_], axis: int, step: int, outside) -> NDArray[np.bool_]:
     """``on`` of each grid cell's neighbour along ``axis`` (``step`` ±1); a neighbour outside the
     grid takes ``outside`` (same shape as ``on``)."""
     nb = np.array(outside, dtype=bool, copy=True)
@@ -106,7 +106,7 @@ def fit_to_boundaries(
             outside = np.ones_like(on)
             if edge.any():
                 outside[edge] = on_at(xi[edge] + shift[0], eta[edge] + shift[1])
-            off = keep & ~_neighbour_on(on, axis, step, outside)
+            off = keep & ~neighbour_values(on, axis, step, outside)
             idx = off[keep]
             if not idx.any():
                 continue

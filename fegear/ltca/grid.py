@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from fegear.geometry.pair_placement import tooth_transform
 from fegear.geometry.transforms import apply_points, apply_vectors, compose
-from fegear.ltca.cell_fit import MIN_FITTED, fit_to_boundaries
+from fegear.ltca.cell_fit import MIN_FITTED, fit_to_boundaries, neighbour_values
 from fegear.tca.core import TCA
 from fegear.tca.results import PositionResult
 from fegear.tca.solve import in_bounds, line_hit
@@ -374,15 +374,8 @@ def _boundary_mask(CU, CV, A, size, inside, ok, guv, b, b2) -> NDArray[np.uint8]
         touches[1] |= nu > b.u_tip
         touches[2] |= nv < b.v_start
         touches[3] |= nv > b.v_end
-        off = np.zeros_like(miss)  # the neighbour is on the pinion's flank, off the gear's
-        if axis == 0 and step == 1:
-            off[:-1] = miss[1:]
-        elif axis == 0:
-            off[1:] = miss[:-1]
-        elif step == 1:
-            off[:, :-1] = miss[:, 1:]
-        else:
-            off[:, 1:] = miss[:, :-1]
+        # the neighbour is on the pinion's flank, off the gear's
+        off = neighbour_values(miss, axis, step, np.zeros_like(miss))
         for k in range(4):
             touches[4 + k] |= off & (nearest == k)
     mask = np.zeros(CU.shape, dtype=np.uint8)
