@@ -196,7 +196,6 @@ def render(doc: dict) -> str:
     dg = g["pitch_angle"] - dm(s["gear_pitch_angle"])
     db = g["spiral_angle"] - dm(s["spiral_angle"]["gear"])
     da0 = g["outer_cone_distance_in"] - s["cone_distance_in"]
-    drive_log = sy["log"][0] if sy["log"] else "(none)"
     err = sy["error"]["text"].replace("\n", "") if sy["error"] else "none"
     err = " ".join(err.split())
     refused = sy["error"] is not None
@@ -343,17 +342,15 @@ pair: {"`fegear run` exits with 2 and" if refused else ""} the message
 
     {err}
 
-The drive side's solution, as fegear logs it, is
-
-    {drive_log}
-
-— a pinion blank offset of metres and a ratio of roll over a hundred: the generating motion has
-run off to infinity, a solution of the equations and not a machine setup, and fegear accepts it
-because its residual is small. The coast side has no solution from fegear's starting point. fegear's
-pinion synthesis varies four settings (cutter radius, ratio of roll, modified roll 2C, blank offset)
-with the machine root angle fixed at the pinion's root angle and no tilt; the sheet's pinion,
-with 50°29' of spiral angle on a 1.500 in offset, is cut with a cutter and setup of its own per
-flank on the No. 16, whose settings are on the page of the sheet the copy does not hold.
+The drive side's equations have a root (residual 1e-12) at a pinion blank offset of metres and a
+ratio of roll over a hundred: the generating motion has run off to infinity, a solution of the
+equations and not a machine setup, and fegear refuses it, naming the settings and their bounds
+(`fegear/geometry/bevel/synthesis.py`, `REACH_FACTOR`); the coast side has no solution from
+fegear's starting point at all. fegear's pinion synthesis varies four settings (cutter radius,
+ratio of roll, modified roll 2C, blank offset) with the machine root angle fixed at the pinion's
+root angle and no tilt; the sheet's pinion, with 50°29' of spiral angle on a 1.500 in offset, is
+cut with a cutter and setup of its own per flank on the No. 16, whose settings are on the page of
+the sheet the copy does not hold.
 
 So there is no TCA and no loaded analysis on this page: the source has none to compare with, its
 pinion's settings are not available, and fegear's synthesis cannot find a pinion for the sheet's

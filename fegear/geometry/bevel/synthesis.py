@@ -309,6 +309,7 @@ def synthesize(
                 f"local synthesis of the {side} side did not converge ({msg.strip()}); "
                 f"residual {np.max(np.abs(res)):.2e}",
             )
+        _check_reachable(side, x, blank, mc1, targets)
         ps = settings1(x)
         env1 = generate(head_cutter(ps), machine_motion(ps), 0.0, 0.0, 0.0, half_width=0.1)
         S_ach = _shape_operator(env1, bpin)
@@ -339,6 +340,38 @@ def synthesize(
             side, x[0], x[1], x[2], x[3], lam, np.max(np.abs(res)),
         )  # fmt: skip
     return SpiralBevelSettings(**out), reports
+
+
+#: The pinion settings a local synthesis may end at, against the blank: the cutter radius within
+#: this factor of the gear's, the ratio of roll of the nominal ``cos δ1 / sin γ1`` (the pinion's
+#: rolling cone on the cradle) and the blank offset within the pinion's mean cone distance. The
+#: reference pairs end at 0.90-0.94 of the cutter radius, 0.91-1.34 of the roll, blank offsets of
+#: 0.10-0.35 of the cone distance; beyond the bounds the equations have a root that is no machine
+#: setup (a 10/41 hypoid's blank: ratio of roll 153, blank offset 3.8 m, residual 1e-12).
+REACH_FACTOR = 2.0
+
+
+def _check_reachable(side: str, x: Array, blank, mc1: float, targets) -> None:
+    """Refuse pinion settings ``x = (r_c1, m_c1, C, E_m1)`` outside :data:`REACH_FACTOR`'s
+    bounds (a root of the synthesis equations that no generator cuts), naming them."""
+    rc, m, _, E = (float(v) for v in x)
+    r0, rm1 = float(blank.cutter_radius_mm), float(blank.mean_cone_distance(1))
+    bad = []
+    if not r0 / REACH_FACTOR <= rc <= r0 * REACH_FACTOR:
+        bad.append(f"cutter radius {rc:.4g} mm (gear's {r0:.4g} mm)")
+    if not mc1 / REACH_FACTOR <= m <= mc1 * REACH_FACTOR:
+        bad.append(f"ratio of roll {m:.4g} (rolling cone's {mc1:.4g})")
+    if abs(E) > rm1:
+        bad.append(f"blank offset {E:.4g} mm (mean cone distance {rm1:.4g} mm)")
+    if bad:
+        raise DesignError(
+            "spiral_bevel.synthesis_targets",
+            targets,
+            "targets the pinion settings can reach",
+            f"local synthesis of the {side} side ended at settings no generator cuts: "
+            + ", ".join(bad)
+            + f" (bounds: within {REACH_FACTOR:g}x, the offset within the cone distance)",
+        )
 
 
 @dataclass(frozen=True)
