@@ -88,7 +88,9 @@ class PairCells:
         flank (``∂r/∂ξ s_ξ``, ``∂r/∂η s_η`` at the cell centre; the half-space near field lays
         each cell out in its own tangent plane from them).
     cell_mm
-        ``(2,)`` mm, cell sizes along the cell axes ``ξ`` and ``η``.
+        ``(2,)`` mm, the grid's cell sizes along the cell axes ``ξ`` and ``η`` (a cell fitted to
+        a flank boundary is shorter or longer along ``η``: its own extent is in ``edges``,
+        :mod:`fegear.ltca.cell_fit`).
     boundary
         ``(n,)`` bool, the cell touches a boundary of the working flank of either member.
     boundary_edges
