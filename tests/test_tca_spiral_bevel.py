@@ -60,7 +60,8 @@ def test_native_flank_is_the_engine_surface(pair):
             assert np.abs(uu - u).max() < 1e-10 and np.abs(vv - v).max() < 1e-9
             # equation of meshing holds (sine of the angle between n and v)
             assert m.native_flank(side).meshing_residual(s, th).max() < 1e-10
-            # analytic IFT tangents vs central differences (FD truncation+round-off ~1e-8)
+            # the map's tangents (the table's derivatives) vs central differences (FD truncation
+            # + round-off ~1e-8)
             rs, rt = fm.jacobian(s, th, fm.evaluate(s + 0.0, th)[0])
             h = 1e-5
             fs = (fm.evaluate(s + h, th)[0] - fm.evaluate(s - h, th)[0]) / (2 * h)

@@ -340,34 +340,35 @@ class FaceGearMap(FlankMap):
 class SpiralBevelMap(FlankMap):
     """Face-milled spiral bevel member; native ``(s, θ)`` = blade parameter and cutter angle.
 
-    Evaluation by :class:`~fegear.geometry.bevel.native.NativeFlank`: the exact envelope, ψ from
-    the equation of meshing by Newton from a tabulated predictor (agrees with the engine's
-    ``point_normal`` to ~1e-13 mm, tested). The Jacobian is analytic (implicit-function theorem),
-    not a finite difference. Flank coordinates ``(u, v)``: the fraction of the working height
-    between this side's fillet-limit curve (where the blade meets its edge radius) and the face
-    cone, and the cone distance ``L`` (mm); a point below the fillet limit has ``u < 0`` and is
+    Evaluation by :class:`~fegear.geometry.bevel.tabulated.TabulatedFlank`: the exact envelope
+    (:class:`~fegear.geometry.bevel.native.NativeFlank`, ψ from the equation of meshing by
+    Newton) tabulated once on a quintic spline, within ``TABLE_TOL_MM`` = 1e-11 mm of it (its
+    error measured when built, tested), exact outside the table. The Jacobian is the spline's
+    derivative, not a finite difference. Flank coordinates ``(u, v)``: the fraction of the working
+    height between this side's fillet-limit curve (where the blade meets its edge radius) and the
+    face cone, and the cone distance ``L`` (mm); a point below the fillet limit has ``u < 0`` and is
     outside the working surface (the fillet itself is not a contact surface of the TCA).
     """
+
+    #: the tabulated flank's evaluation is point by point (an interpolant)
+    pointwise: ClassVar[bool] = True
 
     def _nf(self):
         nf = self._cache.get("nf")
         if nf is None:
-            nf = self._cache["nf"] = self.member.native_flank(self.side)
+            nf = self._cache["nf"] = self.member.tabulated_flank(self.side)
         return nf
 
     def evaluate(self, a, b):
-        # the Newton solves call jacobian(a, b, p) with the p just returned: the tangents are
-        # computed here (IFT, ~30 % extra) and handed over by identity of p
-        p, n, rs, rt = self._nf().evaluate(a, b, tangents=True)
-        self._cache["last"] = (p, rs, rt)
-        return p, n
+        return self._nf().evaluate(a, b)[:2]
 
     def jacobian(self, a, b, p):
-        last = self._cache.get("last")
-        if last is not None and last[0] is p:
-            return last[1], last[2]
         _, _, rs, rt = self._nf().evaluate(a, b, tangents=True)
         return rs, rt
+
+    def point_jacobian(self, a, b):
+        # the tangents come with the point (the splines' derivatives): one evaluation
+        return self._nf().evaluate(a, b, tangents=True)
 
     def flank(self, a, b, p):
         return self._nf().flank(p)

@@ -56,6 +56,7 @@ from .blank import BevelBlank
 from .cutter import EdgeRadius, blade_tip
 from .machine import MachineSettings, blank_placement, head_cutter, machine_motion, point_plane
 from .native import NativeFillet, NativeFlank, cone_coords
+from .tabulated import tabulate
 
 __all__ = ["FlankEvaluation", "FilletLimit", "SpiralBevelMember"]
 
@@ -538,6 +539,17 @@ class SpiralBevelMember:
             self.settings(side)  # validates the side
             nf = self._cache[key] = NativeFlank.build(self, side)
         return nf
+
+    def tabulated_flank(self, side: Side) -> NativeFlank:
+        """:meth:`native_flank` tabulated once (built once, cached): the same flank to
+        :data:`~.tabulated.TABLE_TOL_MM`, ~8× cheaper per call of a few points
+        (:class:`~.tabulated.TabulatedFlank`; the exact evaluator if no table meets the
+        tolerance)."""
+        key = ("tabulated", side)
+        tf = self._cache.get(key)
+        if tf is None:
+            tf = self._cache[key] = tabulate(self.native_flank(side))
+        return tf
 
     def native_fillet(self, side: Side) -> NativeFillet:
         """Fast exact evaluator of the ``side`` fillet in the edge-radius parameters ``(ϑ, θ)``
