@@ -36,15 +36,19 @@ def test_the_table_is_the_exact_flank(which, request):
         s, th = _sample(tf, 4000, tabulated.MARGIN, seed=1)
         p0, n0, rs0, rt0 = NativeFlank.evaluate(tf, s, th, tangents=True)
         p, n, rs, rt = tf.evaluate(s, th, tangents=True)
+        lo, hi = tf.box
+        x = np.stack([s, th], -1)
+        near = (np.maximum(lo - x, x - hi) / (hi - lo)).max(-1) <= tabulated.NEAR
         # the build measures between every 4th node pair; random points between all nodes
         # may reach a little past it: 2x (the spline's error is smooth, no node is special)
-        assert np.linalg.norm(p - p0, axis=-1).max() < 2 * TABLE_TOL_MM, (m.name, side)
-        # unit normals: ~the point error over the flank's curvature radii (> 1 mm)
-        assert np.linalg.norm(n - n0, axis=-1).max() < 2 * TABLE_TOL_MM, (m.name, side)
-        # tangents: one order of the grid step less (h ~ span/144), scaled by |r_s|, |r_θ|
-        # (~1-100 mm per unit): 1e-8 of them
-        assert np.abs(rs - rs0).max() < 1e-8 * np.abs(rs0).max(), (m.name, side)
-        assert np.abs(rt - rt0).max() < 1e-8 * np.abs(rt0).max(), (m.name, side)
+        for sel, tol in ((near, TABLE_TOL_MM), (~near, tabulated.FAR_TOL_MM)):
+            assert np.linalg.norm(p - p0, axis=-1)[sel].max() < 2 * tol, (m.name, side)
+            # unit normals: ~the point error over the flank's curvature radii (> 1 mm)
+            assert np.linalg.norm(n - n0, axis=-1)[sel].max() < 2 * tol, (m.name, side)
+        # tangents near the flank: one order of the grid step less (h ~ span/90), scaled by
+        # |r_s|, |r_θ| (~1-100 mm per unit): 1e-8 of them
+        assert np.abs(rs - rs0)[near].max() < 1e-8 * np.abs(rs0).max(), (m.name, side)
+        assert np.abs(rt - rt0)[near].max() < 1e-8 * np.abs(rt0).max(), (m.name, side)
         # a point is the same number whether its tangents are asked or not
         p1, n1 = tf.evaluate(s, th)
         assert np.array_equal(p1, p) and np.array_equal(n1, n)
@@ -67,7 +71,7 @@ def test_a_flank_no_table_can_meet_keeps_its_exact_evaluator(spiral_bevel_pair, 
     monkeypatch.setattr(tabulated, "NODES", (21,))
     assert tabulate(nf) is nf
     # and a table that meets it is returned with its error
-    monkeypatch.setattr(tabulated, "NODES", (21, 161))
+    monkeypatch.setattr(tabulated, "NODES", (21, 201))
     tf = tabulate(nf)
     assert isinstance(tf, TabulatedFlank) and tf.error_mm <= TABLE_TOL_MM
 

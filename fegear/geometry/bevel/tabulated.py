@@ -9,7 +9,7 @@ it (the box within which the solves clamp their steps) and interpolated by tenso
 quintic splines (:class:`scipy.interpolate.RectBivariateSpline`, ``k = 5``; de Boor 2001,
 ch. XVII). The interpolation error of a spline of degree ``k`` is ``O(h^{k+1})`` in the grid
 step ``h`` (de Boor 2001, ch. XII): on the reference 12/36 spiral bevel and the 10/41 hypoid,
-161 × 161 nodes over twice the working box give ≤ 1.5e-12 mm on the points and ≤ 3e-14 on the
+201 × 201 nodes over twice the working box give ≤ 1e-11 mm on the points and ≤ 3e-14 on the
 normals against the exact evaluator (``docs/geometry/tabulated_flank.md``), two orders below
 the TCA's Newton tolerance (1e-10 mm). Tangents are the spline's own derivatives.
 
@@ -22,11 +22,12 @@ and a flank that cannot be tabulated to it keeps its exact evaluator
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ...errors import SolverError
 from .native import NativeFlank
 
 __all__ = ["TabulatedFlank", "TABLE_TOL_MM", "tabulate"]
@@ -38,12 +39,19 @@ Array = NDArray[np.float64]
 #: TCA's Newton solves stop at 1e-10 mm (``fegear.tca.solve.TOL_MM``): a table ten times below
 #: it does not move a contact point beyond the solves' own resolution
 TABLE_TOL_MM = 1e-11
-#: the table covers the working box widened by this fraction of its span on each side (the
-#: converged points of the TCA lie in the box; its solves may step up to half a span beyond it,
-#: where the exact flank answers)
-MARGIN = 0.25
-#: nodes per direction tried in turn until :data:`TABLE_TOL_MM` holds
-NODES = (161, 241, 321)
+#: the working box (the flank's range of (s, θ)) and a quarter of its span around it: every point
+#: of the working flank lies there; the table must meet TABLE_TOL_MM there
+NEAR = 0.25
+#: further out only trial steps of the Newton solves go, and points that stop there are off the
+#: working flank by more than a quarter span (no contact): 1e-9 mm (2.6 % of the points the
+#: spiral bevel's ΔE run evaluates)
+FAR_TOL_MM = 1e-9
+#: the table covers the working box widened by this fraction of its span on each side: the TCA's
+#: solves clamp their steps half a span beyond the box (``fegear.tca.solve``); 6 % of their
+#: calls on the spiral bevel reach past a quarter span
+MARGIN = 0.5
+#: nodes per direction tried in turn until :data:`TABLE_TOL_MM` and :data:`FAR_TOL_MM` hold
+NODES = (201, 281)
 #: spline degree (quintic: error O(h⁶))
 DEGREE = 5
 
@@ -65,9 +73,12 @@ class TabulatedFlank(NativeFlank):
         ``(lo, hi)`` of the tabulated ``(s, θ)``; outside it :meth:`evaluate` is exact.
     error_mm
         Largest distance of the tabulated points from the exact flank measured at build time
-        (at the centres of a sample of grid cells), mm.
+        (at the centres of a sample of grid cells)
+        within :data:`NEAR` spans of the working box, mm.
     normal_error
         Largest difference of the unit normals there.
+    far_error_mm
+        Largest distance further out (where only the Newton solves' trial steps go), mm.
     """
 
     coef: Array
@@ -75,6 +86,7 @@ class TabulatedFlank(NativeFlank):
     table_box: tuple[Array, Array]
     error_mm: float = np.nan
     normal_error: float = np.nan
+    far_error_mm: float = np.nan
 
     def evaluate(self, s: ArrayLike, th: ArrayLike, tangents: bool = False) -> tuple[Array, ...]:
         """Points ``(..., 3)`` and unit normals; with ``tangents`` also ``r_s``, ``r_θ`` (the
@@ -189,9 +201,42 @@ def _table(nf: NativeFlank, n: int) -> TabulatedFlank | None:
     S, T = (x.ravel() for x in np.meshgrid(cs, ct, indexing="ij"))
     Pe, Ne = NativeFlank.evaluate(nf, S, T)
     Pt, Nt = tab._interpolate(S, T, False)
-    err = float(np.max(np.linalg.norm(Pt - Pe, axis=-1)))
-    nerr = float(np.max(np.linalg.norm(Nt - Ne, axis=-1)))
-    return TabulatedFlank(*_fields(nf), coef, axes, (tlo, thi), err, nerr)
+    dp = np.linalg.norm(Pt - Pe, axis=-1)
+    dn = np.linalg.norm(Nt - Ne, axis=-1)
+    # how far beyond the working box, in spans (0 inside it)
+    beyond = np.maximum(
+        np.maximum(lo - np.stack([S, T], -1), np.stack([S, T], -1) - hi) / span, 0
+    ).max(-1)
+    near = beyond <= NEAR
+    return TabulatedFlank(
+        *_fields(nf), coef, axes, (tlo, thi), float(dp[near].max()), float(dn[near].max()),
+        float(dp[~near].max()) if (~near).any() else 0.0,
+    )  # fmt: skip
+
+
+def _with_inverse(tab: TabulatedFlank, n: int = 33) -> TabulatedFlank:
+    """``tab`` with a finer predictor of its inversion ``(u, v) → (s, θ)``
+    (:meth:`~.native.NativeFlank.native_evaluation`): quintic splines through ``n × n`` points
+    of the working flank (where the 9 × 9 bicubic predictor it is built with was fitted), each
+    inverted by that Newton on the table. The Newton then starts within ~1e-9 mm of the root and
+    needs one step where it needed two; it ends at the same tolerance, so the result does not
+    depend on the predictor beyond it. ``tab`` unchanged if an inversion fails (logged)."""
+    from scipy.interpolate import RectBivariateSpline
+
+    b = tab.member.boundaries()
+    uu = np.linspace(b.u_fillet, b.u_tip, n)
+    vv = np.linspace(b.v_start, b.v_end, n)
+    try:
+        s, th = tab.native(*np.meshgrid(uu, vv, indexing="ij"))
+    except SolverError as e:  # pragma: no cover - the working flank inverts on every pair seen
+        log.info("%s %s: finer inverse predictor not built (%s)", tab.member.name, tab.side, e)
+        return tab
+    k = DEGREE
+    inverse = (
+        RectBivariateSpline(uu, vv, s, kx=k, ky=k),
+        RectBivariateSpline(uu, vv, th, kx=k, ky=k),
+    )
+    return replace(tab, inverse=inverse)
 
 
 def _fields(nf: NativeFlank) -> tuple:
@@ -207,7 +252,8 @@ def tabulate(nf: NativeFlank) -> NativeFlank:
         if tab is None:
             break
         err = tab.error_mm
-        if err <= TABLE_TOL_MM:
+        if err <= TABLE_TOL_MM and tab.far_error_mm <= FAR_TOL_MM:
+            tab = _with_inverse(tab)
             log.debug("%s %s flank tabulated on %d x %d nodes: %.1e mm, normals %.1e",
                       nf.member.name, nf.side, n, n, err, tab.normal_error)  # fmt: skip
             return tab
