@@ -159,7 +159,8 @@ def _loaded_warnings(run: GearRun, h, te_l, te_l_why, missed: bool) -> list[str]
         warnings.append(
             f"contact cells coarser than asked at {len(capped)} of {n} positions ([contact] "
             f"max_cells caps the cells of one pair; e.g. {cap.removeprefix(CAPPED).strip()}): "
-            "raise max_cells, or leave max_cells and cell_mm to their defaults"
+            "raise [contact] max_cells to reach them (the cells across each loaded patch: "
+            "positions[i].pairs[j].cells_across_patch in summary.json)"
         )
     if degen:
         where = (
