@@ -78,13 +78,11 @@ def test_iso6336_3_critical_section_is_the_generated_fillets():
 
 
 @pytest.fixture(scope="module")
-def fzg_stress():
-    """FZG hybrid level 0 at two positions (one in single contact), loaded stress sectors with
-    coarse fillets (0.5 m: a small solve; the equilibrium does not depend on the size)."""
+def fzg_cycle():
+    """FZG hybrid level 0 at two positions (one in single contact): the case, pair, assembly,
+    models, loaded cycle and gear angles."""
     from fegear.ltca import LTCAOptions, build_models, run_ltca
-    from fegear.pipeline.fields import displacements
     from fegear.pipeline.pair import build_pair
-    from fegear.pipeline.run import GearRun
     from fegear.tca.results import ARCSEC
     from fegear.validation.iso6336_root import _fzg_case
 
@@ -97,9 +95,56 @@ def fzg_stress():
                    models=models)  # fmt: skip
     asm = pair.assembly.with_phase2(cyc.phase2)
     phi2 = asm.ratio * cyc.phi1 + cyc.te_unloaded_arcsec * ARCSEC
+    return case, pair, asm, models, cyc, phi2
+
+
+@pytest.fixture(scope="module")
+def fzg_stress(fzg_cycle):
+    """The loaded stress sectors of :func:`fzg_cycle` with coarse fillets (0.5 m: a small
+    solve; the equilibrium does not depend on the size)."""
+    from fegear.pipeline.fields import displacements
+    from fegear.pipeline.run import GearRun
+
+    case, pair, asm, models, cyc, phi2 = fzg_cycle
     fields = displacements(pair, asm, models, cyc, phi2, fillet_modules=0.5)
-    run = GearRun(case=case, pair=pair, assembly=asm, cycle=cyc, members=fields)
-    return run
+    return GearRun(case=case, pair=pair, assembly=asm, cycle=cyc, members=fields)
+
+
+def test_stress_solve_is_a_direct_solve_and_keeps_no_factor(fzg_cycle, fzg_stress):
+    """The stress sector's solve (:func:`fegear.pipeline.fields._stress_solve`: one factor,
+    released, the full stiffness dropped but its clamped rows) gives the displacement of the
+    full system ``K u = F`` with its clamped DOFs fixed (relative residual 1e-9: a direct
+    solve leaves round-off) and the reactions of the full stiffness (the same rows, the same
+    products: 1e-12 of the load); and no stress sector's factor stays in the process."""
+    import scipy.sparse as sp
+
+    from fegear.fem.assembly import elasticity_stiffness
+    from fegear.fem.stress import reactions
+    from fegear.pipeline import fields as F
+
+    case, pair, asm, models, cyc, phi2 = fzg_cycle
+    model = models.pinion
+    module = float(model.sector.parameters["h_fine_mm"]) / F.FINE[0]
+    sm = F.stress_sector(pair.pinion, model, None, 0.5 * module)
+    body = sm.body
+    place = np.stack([asm.placement1(p.phi1) for p in cyc.positions])
+    loads = F._member_loads("pinion", sm, place, cyc, body.n_dofs)
+    u = np.zeros_like(loads)
+    u[body.free], rows, used = F._stress_solve(body, loads)
+    K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
+    Kf = K[body.free][:, body.free]
+    for i in range(loads.shape[1]):
+        b = loads[body.free, i]
+        assert np.linalg.norm(Kf @ u[body.free, i] - b) < 1e-9 * np.linalg.norm(b)
+        fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
+        mine = reactions(rows, body.basis.doflocs, fixed, u[:, i], loads[:, i])
+        full = reactions(K, body.basis.doflocs, fixed, u[:, i], loads[:, i])
+        scale = np.linalg.norm(full.applied_N)
+        assert np.abs(mine.reaction_N - full.reaction_N).max() < 1e-12 * scale
+    assert sp.issparse(rows) and rows.getnnz(axis=1)[body.free].max() == 0  # clamped rows only
+    assert used in ("pardiso", "superlu")
+    assert not any(key[0] == str(sm.sector.path) for key in F._FACTORS)  # fzg_stress's mesh
+    assert all(len(mf.equilibrium) == 2 for mf in fzg_stress.members)  # the fixture solved
 
 
 def test_each_stress_solve_is_in_equilibrium(fzg_stress):

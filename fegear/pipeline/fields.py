@@ -131,9 +131,10 @@ class MemberField:
 #: without ``dofs`` and ``body``).
 FIELD_CLASSES = registry(MemberField, ToothRootStress, Equilibrium)
 
-#: Factorised stress sectors kept in the process (the last pair): runs of the same pair in one
-#: process (sweeps, scripts, the test session) solve by back-substitution only. A 190k-DOF FZG
-#: stress sector's Cholesky is some hundred MB, hence two.
+#: Factorised contact sectors kept in the process (the last pair): runs of the same pair in one
+#: process (sweeps, scripts, the test session) solve their fields by back-substitution only.
+#: The stress sectors' factors are never kept (:func:`_stress_solve`: 2.2-2.4 GB each on the
+#: seed face gear).
 _FACTORS: OrderedDict[tuple, tuple[sp.csr_matrix, SparseFactor]] = OrderedDict()
 _MAX_FACTORS = 2
 _FACTORS_LOCK = threading.Lock()  # the members' solves look their factors up in threads
@@ -154,6 +155,34 @@ def _factorised(sector, body, backend: str = "auto") -> tuple[sp.csr_matrix, Spa
         while len(_FACTORS) > _MAX_FACTORS:
             _FACTORS.popitem(last=False)
         return K, factor
+
+
+def _stress_solve(body, F: Array, backend: str = "auto") -> tuple[Array, sp.csr_matrix, str]:
+    """``(u_free, K_rows, solver)``: the displacement on the free DOFs of a stress sector under
+    the loads ``F`` (``(n_dofs, n_positions)`` N, all positions in one solve), the rows of the
+    full stiffness on the clamped DOFs (the rest zero: all :func:`fegear.fem.stress.reactions`
+    reads of it, the same products) and the backend that solved.
+
+    One factorisation, released on return, and never kept in :data:`_FACTORS`: a stress
+    sector's factor is most of the memory of a root-stress run (seed face gear: 269 and 304
+    million entries in ``L``, 2.2 and 2.4 GB; keeping both, as the contact sectors' are kept,
+    took the run to 8.7 GB), so the members are factorised one after the other and the full
+    stiffness is dropped before the factorisation (``benchmarks/results/root_stress_cost.md``).
+    A repeated run reads its fields from the cache (``member_fields``) instead."""
+    K = elasticity_stiffness(body.mesh, body.E, body.nu).tocsr()
+    fixed = np.setdiff1d(np.arange(body.n_dofs), body.free)
+    R = K[fixed]  # the clamped rows, placed back at their rows of K (the others empty)
+    count = np.zeros(body.n_dofs + 1, dtype=np.int64)
+    count[fixed + 1] = np.diff(R.indptr)
+    rows = sp.csr_matrix((R.data, R.indices, np.cumsum(count)), shape=K.shape)
+    Kf = K[body.free][:, body.free].tocsr()
+    del K
+    factor = factorize_spd(Kf, backend)
+    del Kf
+    u = factor.solve(np.ascontiguousarray(F[body.free]))
+    used = factor.backend
+    del factor  # the last reference: PARDISO's memory is released now (phase -1)
+    return u, rows, used
 
 
 def _vertex_displacements(
@@ -283,11 +312,13 @@ def displacements(
     (:func:`fegear.ltca.model.member_load_operator`: pinion cells along ``−n1`` at the pinion
     flank points, gear cells along ``+n1`` at the points displaced by the cell gap), so the
     forces are the solver's. All positions are the columns of one right-hand side (one
-    factorisation per member). The rigid lag ``θ`` of member 2 is not part of ``u`` (the
-    sectors are clamped at the bore and the cuts); the VTK places the gear at its unloaded
-    (TCA-closed) angle. Then, per position, the recovered vertex stresses, the root stress of
-    every tooth that can touch (:func:`fegear.fem.stress.tooth_root_stress`) and the
-    equilibrium of the solve (:func:`fegear.fem.stress.reactions`).
+    factorisation per member; with ``root_stress`` the members one after the other, each
+    factor released before the next sector is meshed: :func:`_stress_solve`). The rigid lag
+    ``θ`` of member 2 is not part of ``u`` (the sectors are clamped at the bore and the cuts);
+    the VTK places the gear at its unloaded (TCA-closed) angle. Then, per position, the
+    recovered vertex stresses, the root stress of every tooth that can touch
+    (:func:`fegear.fem.stress.tooth_root_stress`) and the equilibrium of the solve
+    (:func:`fegear.fem.stress.reactions`).
 
     ``refine_teeth``: ``{member: sector teeth}`` whose flank (and fillets) the stress sector
     refines (default: every tooth that can carry load; a refinement study refines the tooth it
@@ -362,6 +393,9 @@ def _members(
             ctx = contextvars.copy_context()  # the cache's and the journal's context
             solves[len(out)] = pool.submit(ctx.run, _vertex_displacements, smodel, body, F,
                                            vdofs, backend, 1)  # fmt: skip
+        elif loaded.size and root_stress:
+            full[body.free], K, used = _stress_solve(body, F, backend)
+            U = np.transpose(full[vdofs], (2, 0, 1))
         elif loaded.size:
             K, factor = _factorised(smodel.sector, body, backend)
             used = factor.backend
