@@ -48,6 +48,8 @@ from fegear.io.schema import (
     check_table,
     reference_markdown,
 )
+from fegear.io.topography import FLANKS as TOPOGRAPHY_FLANKS
+from fegear.io.topography import TopographyGrid, read_topography
 from fegear.options import ContactOptions
 from fegear.units import TORQUE_KEYS, nm_from_nmm, torque2_Nmm_from
 from fegear.units import pinion_torque_Nm as _pinion_torque_Nm
@@ -589,6 +591,19 @@ CONTACT = Section(
 )  # fmt: skip
 
 
+TOPOGRAPHY = Section(
+    "topography",
+    tuple(
+        Key(k, STRING, f"measured grid of the {k.replace('_', ' ')} flank: a CSV file of normal "
+            "deviations in µm (relative to the case file)")
+        for k in TOPOGRAPHY_FLANKS
+    ),
+    "Measured flanks (docs/measured_flanks.md): per member and side a grid of normal deviations "
+    "from the generated flank, interpolated by a spline and added to it in the TCA and the "
+    "loaded analysis. The sector meshes stay those of the design.",
+)  # fmt: skip
+
+
 def sections(kind: str) -> tuple[Section, ...]:
     """The sections of a gear case of ``kind`` (``[pair]`` and ``[errors]`` by kind)."""
     errors = Section(
@@ -596,12 +611,12 @@ def sections(kind: str) -> tuple[Section, ...]:
         ERROR_KEYS["parallel" if kind in PARALLEL_KINDS else "intersecting"],
         "Installation errors, all 0 by default (sign conventions: fegear.geometry.pair_placement).",
     )
-    return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL, CONTACT)
+    return (CASE, PAIR_SECTIONS[kind], LOAD, errors, ANALYSIS, MATERIAL, CONTACT, TOPOGRAPHY)
 
 
 def reference() -> str:
     """The gear case-file reference (Markdown), from the declarations."""
-    common = (CASE, LOAD, ANALYSIS, MATERIAL, CONTACT)
+    common = (CASE, LOAD, ANALYSIS, MATERIAL, CONTACT, TOPOGRAPHY)
     errors = tuple(
         Section("errors", keys, f"Installation errors, {what}; all 0 by default.")
         for keys, what in ((ERROR_KEYS["intersecting"], _INTERSECTING),
@@ -647,6 +662,10 @@ class GearCase:
     machine
         The ``[machine]`` section of a bevel case as written (the flank tables with their
         units), None where the settings are synthesized; :meth:`flank_tables` in mm/deg.
+    topography
+        The ``[topography]`` grids by key (``"pinion_drive"``, ...; :mod:`fegear.io.topography`),
+        empty for the design flanks; ``topography_files`` the file names as the case file
+        gives them (relative to its folder).
     """
 
     name: str
@@ -669,6 +688,8 @@ class GearCase:
     description: str = ""
     source: str = "<memory>"
     machine: dict[str, Any] | None = None
+    topography: dict[str, TopographyGrid] = field(default_factory=dict)
+    topography_files: dict[str, str] = field(default_factory=dict)
 
     def flank_tables(self) -> dict[str, FlankTable] | None:
         """The machine settings of the ``[machine]`` section per flank, in mm and degrees
@@ -721,6 +742,8 @@ class GearCase:
             doc["contact"] = self.contact.given()
         if self.machine is not None:
             doc["machine"] = copy.deepcopy(self.machine)
+        if self.topography_files:
+            doc["topography"] = dict(self.topography_files)
         return doc
 
     def replace(self, **changes: Any) -> GearCase:
@@ -740,7 +763,9 @@ class GearCase:
             :class:`~fegear.options.ContactOptions` or a mapping of the ``[contact]`` keys: it
             replaces all of them, the ones not given take their defaults), a load, which
             replaces the case's torque (``torque2_Nm``, N·m, or ``torque2_Nmm``, N·mm, on
-            member 2; ``pinion_torque_Nm``, N·m, on member 1), and ``source``.
+            member 2; ``pinion_torque_Nm``, N·m, on member 1), ``topography`` (a mapping of
+            the ``[topography]`` keys to grid files: it replaces all of them; ``{}`` the design
+            flanks) and ``source``.
 
         Returns
         -------
@@ -775,6 +800,12 @@ class GearCase:
                 if not isinstance(value, dict):
                     raise InputError("pair", value, "a mapping of the [pair] keys")
                 doc["pair"] = value
+            elif key == "topography":
+                if not isinstance(value, dict):
+                    raise InputError("topography", value, "a mapping of the [topography] keys")
+                doc["topography"] = {k: str(v) for k, v in value.items()}
+                if not value:
+                    doc.pop("topography")
             elif key == "contact":
                 if isinstance(value, ContactOptions):
                     value = value.given()
@@ -789,7 +820,15 @@ class GearCase:
                 doc["errors"] = value
             else:
                 known = sorted(
-                    [*_REPLACE_KEYS, *TORQUE_KEYS, "pair", "errors", "contact", "source"]
+                    [
+                        *_REPLACE_KEYS,
+                        *TORQUE_KEYS,
+                        "pair",
+                        "errors",
+                        "contact",
+                        "topography",
+                        "source",
+                    ]
                 )
                 close = difflib.get_close_matches(key, known, n=1, cutoff=0.5)
                 hint = f"did you mean {close[0]!r}?" if close else ""
@@ -857,6 +896,11 @@ class GearCase:
                 {}
                 if self.machine is None
                 else {"machine": {f: vars(t) for f, t in (self.flank_tables() or {}).items()}}
+            ),
+            **(
+                {"topography": {k: g.echo() for k, g in self.topography.items()}}
+                if self.topography
+                else {}
             ),
         }
 
@@ -940,7 +984,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     kind = data["case"].get("kind") if isinstance(data["case"], dict) else None
     if kind not in GEAR_KINDS:
         raise InputError("case.kind", kind, f"one of {GEAR_KINDS}")
-    case_s, pair_s, load_s, errors_s, analysis_s, material_s, contact_s = sections(kind)
+    case_s, pair_s, load_s, errors_s, analysis_s, material_s, contact_s, topo_s = sections(kind)
     machine = data.get("machine") if kind in BEVEL_KINDS else None
     check_document({k: v for k, v in data.items() if machine is None or k != "machine"},
                    sections(kind))  # fmt: skip
@@ -959,6 +1003,9 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     ana = check_table(analysis_s, data.get("analysis", {}))
     mat = check_table(material_s, data.get("material", {}))
     tuning = check_table(contact_s, data.get("contact", {}))
+    files = check_table(topo_s, data.get("topography", {}))
+    folder = Path(source).parent if source != "<memory>" else Path.cwd()
+    grids = {k: read_topography(k, str(files[k]), folder) for k in TOPOGRAPHY_FLANKS if k in files}
 
     given = [k for k in TORQUE_KEYS if k in load]
     if len(given) != 1:
@@ -1014,6 +1061,8 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         description=case_s.value(case, "description"),
         source=source,
         machine=copy.deepcopy(machine),
+        topography=grids,
+        topography_files={k: str(files[k]) for k in grids},
     )
 
 

@@ -31,6 +31,7 @@ from fegear.geometry.pair_placement import (
 )
 from fegear.io.gear_case import PAIR_SECTIONS, GearCase
 from fegear.store.cache import cached_file
+from fegear.tca.deviation import MeasuredMember, flank_topography
 
 __all__ = ["FAMILIES", "Family", "GearPair", "assemble", "build_pair", "family"]
 
@@ -427,9 +428,27 @@ def build_pair(case: GearCase) -> GearPair:
     Raises
     ------
     InputError, DesignError
-        Design data that cannot make a valid tooth, naming the case-file key.
+        Design data that cannot make a valid tooth, naming the case-file key; a
+        ``[topography]`` grid off the working flank (naming its file, row and column).
     """
-    return family(case).build(case)
+    return measured(case, family(case).build(case))
+
+
+def measured(case: GearCase, pair: GearPair) -> GearPair:
+    """``pair`` with the case's ``[topography]`` grids on its members' flanks
+    (:class:`~fegear.tca.deviation.MeasuredMember`; the assembly and the bevel pair are the
+    generated ones): ``pair`` itself without a topography."""
+    if not case.topography:
+        return pair
+    members = []
+    for name, m in (("pinion", pair.pinion), ("gear", pair.gear)):
+        topo = tuple(
+            (g.side, flank_topography(g, m, g.side))
+            for g in case.topography.values()
+            if g.member == name
+        )
+        members.append(MeasuredMember(m, topo) if topo else m)
+    return GearPair(members[0], members[1], pair.assembly, pair.spiral_bevel)
 
 
 def assemble(case: GearCase, pair: GearPair, errors: InstallationErrors) -> Assembly:

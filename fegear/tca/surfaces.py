@@ -404,8 +404,13 @@ def flank_map(member: GeneratedMember, side: str, generic: bool = False) -> Flan
     Working-flank bounds (``member.flank_coordinates(side).bounds``): ``u`` from the fillet
     limit to the tip, ``v`` over the face. The fast map is the one :data:`FAST_FLANK_MAPS`
     registers under the member's ``fast_evaluator``; otherwise, or with ``generic``,
-    :class:`GenericFlankMap` with the member's steps.
+    :class:`GenericFlankMap` with the member's steps. A member with measured flanks
+    (:class:`fegear.tca.deviation.MeasuredMember`) gives its own map (``measured_flank_map``:
+    this map of its generated member, deviated by the topography).
     """
+    measured = getattr(member, "measured_flank_map", None)
+    if measured is not None:
+        return measured(side, generic)
     fc = member.flank_coordinates(side)
     fast = None if generic or fc.fast_evaluator is None else FAST_FLANK_MAPS.get(fc.fast_evaluator)
     if fast is not None:
