@@ -540,7 +540,8 @@ ANALYSIS = Section(
             "root_stress",
             BOOLEAN,
             "tooth root stress (fe, hybrid): the sectors remeshed with refined fillets, one "
-            "more sparse factorisation per member (seed face gear: about 1-2 min, 8 GB)",
+            "more sparse factorisation per member, one member at a time (seed face gear: about "
+            "2 min, 4.9 GB peak)",
             default=False,
         ),
     ),
