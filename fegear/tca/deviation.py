@@ -32,7 +32,13 @@ from scipy.interpolate import BSpline, make_interp_spline
 from ..errors import InputError
 from .surfaces import FlankMap, SpurInvoluteMap, flank_map
 
-__all__ = ["DeviatedFlankMap", "FlankTopography", "MeasuredMember", "flank_topography"]
+__all__ = [
+    "DeviatedFlankMap",
+    "FlankTopography",
+    "MeasuredMember",
+    "flank_topography",
+    "normal_deviation",
+]
 
 Array = NDArray[np.float64]
 
@@ -331,3 +337,30 @@ class MeasuredMember:
         design are shared (µm deviations do not change the compliance)."""
         b = self.base
         return b.mesh_member() if hasattr(b, "mesh_member") else b
+
+
+def normal_deviation(
+    nominal: FlankMap, modified: FlankMap, u: ArrayLike, v: ArrayLike, tol: float = 1e-13
+) -> Array:
+    """What a measuring machine reads on ``modified`` at the nominal flank coordinates
+    ``(u, v)``: the distance ``δ`` (mm, positive = material removed) along the nominal outward
+    normal ``n`` from the nominal point ``P`` to the modified flank.
+
+    Newton on ``X(a', b') + δ n = P`` for ``(a', b', δ)`` (``X`` the modified map, its tangents
+    from :meth:`~fegear.tca.surfaces.FlankMap.point_jacobian`), from ``(a, b, 0)``; stops when
+    the residual is below ``tol`` mm (at most 20 steps). Used to make a topography grid of an
+    analytic modification (``tests/test_topography_runs.py``, ``cases/helical_measured*``).
+    """
+    a, b = nominal.native(u, v)
+    P, n = nominal.evaluate(a, b)
+    x, y = a.copy(), b.copy()
+    d = np.zeros(a.shape)
+    for _ in range(20):
+        X, _, Xa, Xb = modified.point_jacobian(x, y)
+        F = X - P + d[..., None] * n
+        if F.size == 0 or np.abs(F).max() < tol:
+            break
+        J = np.stack([Xa, Xb, n], -1)
+        step = np.linalg.solve(J, -F[..., None])[..., 0]
+        x, y, d = x + step[..., 0], y + step[..., 1], d + step[..., 2]
+    return d
