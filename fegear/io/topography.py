@@ -170,7 +170,7 @@ def parse_topography(text: str, key: str, path: Path) -> TopographyGrid:
     profile, dev, line_of = [], [], []
     for r, cells in rows[1:]:
         if len(cells) != n_f + 1:
-            col = min(len(cells), n_f + 1) + (1 if len(cells) > n_f + 1 else 0)
+            col = len(cells) + 1 if len(cells) < n_f + 1 else n_f + 2  # the first missing/extra
             raise InputError(_field(key, path, r, col), f"{len(cells)} cells",
                              f"{n_f + 1} cells: a profile coordinate and {n_f} deviations "
                              "(one per face coordinate of the header)")  # fmt: skip
