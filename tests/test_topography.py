@@ -1,4 +1,4 @@
-"""Measured flanks (issue 47): the grid files, their refusals, the spline and the deviated flank map.
+"""Measured flanks (issue 47): grid files, their refusals, the spline, the deviated flank map.
 
 No analysis runs here (``tests/test_topography_runs.py`` runs the pairs).
 """
@@ -106,13 +106,14 @@ def test_the_command_line_refuses_a_bad_grid_before_any_work(tmp_path, capsys):
 
 def _diameters(member, side="drive"):
     bd = member.flank_coordinates(side).bounds
-    return [2 * math.hypot(member.r_b, float(member.roll_length(u))) for u in (bd.u_fillet, bd.u_tip)]
+    us = (bd.u_fillet, bd.u_tip)
+    return [2 * math.hypot(member.r_b, float(member.roll_length(u))) for u in us]
 
 
 def test_a_physical_grid_off_the_working_flank_is_refused(tmp_path, capsys):
     pinion = build_pair(fegear.load_case(HELICAL)).pinion
     d_form, d_tip = _diameters(pinion)
-    grid = (f"diameter_mm, -7, 0, 7\n{d_form:.6f}, 1, 0, 1\n{d_tip + 0.01:.6f}, 1, 0, 1\n")
+    grid = f"diameter_mm, -7, 0, 7\n{d_form:.6f}, 1, 0, 1\n{d_tip + 0.01:.6f}, 1, 0, 1\n"
     path = _case_file(tmp_path, grid)
     out = tmp_path / "out"
     code = main(["run", str(path), "--out", str(out)])
@@ -137,8 +138,9 @@ def test_the_case_file_section_and_the_summary_echo(tmp_path):
     case = fegear.load_case(_case_file(tmp_path, GOOD))
     assert set(case.topography) == {"pinion_drive"}
     echo = case.to_dict()["topography"]["pinion_drive"]
-    assert echo == {"file": "grid.csv", "sha256": case.topography["pinion_drive"].sha256,
-                    "coordinates": "normalized", "shape": [3, 3], "max_um": 3.0, "min_um": 0.0}  # fmt: skip
+    sha = case.topography["pinion_drive"].sha256
+    assert echo == {"file": "grid.csv", "sha256": sha, "coordinates": "normalized",
+                    "shape": [3, 3], "max_um": 3.0, "min_um": 0.0}  # fmt: skip
     # a new case keeps its grids (paths relative to the case file); {} removes them
     assert case.replace(n_positions=5).topography == case.topography
     assert case.replace(topography={}).topography == {}
