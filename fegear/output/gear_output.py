@@ -73,6 +73,9 @@ Files written to the output folder (each one atomically: complete or absent):
   pressure seen over the cycle), ``root_stress.png`` (per member, the root stress of one tooth
   over its passage through the mesh). Fidelity ``tca``: ``te.png`` and ``bearing_pattern.png``
   (unloaded, paint thickness).
+- ``ease_off.png``, ``ease_off.vts``, ``ease_off.json`` (every fidelity) — the ease-off of the
+  pair over the pinion flank (:mod:`fegear.output.ease_off_output`, ``docs/ease_off.md``): its
+  numbers are in ``ease_off.json``, not in ``summary.json``.
 """
 
 from __future__ import annotations
@@ -83,6 +86,7 @@ from typing import Any
 
 from fegear.forked import apart, process_count
 from fegear.output.cylindrical_output import plot_line_load
+from fegear.output.ease_off_output import write_ease_off
 from fegear.output.flank_view import (
     FlankFrame,
     FlankPatch,
@@ -192,6 +196,7 @@ def write_gear_outputs(
             paths.append(plot_line_load(out, run))
     else:
         paths += tca_plots(out, run)
+    paths += write_ease_off(out, run)
     files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]
     # the summary last: its presence says the run is complete
     paths.append(write_json(out / "summary.json", summary_document(result, files)))
