@@ -91,6 +91,8 @@ _PHASE_ANALYSIS_FACTOR = 12
 _PHASE_SOLVE = 33
 _PHASE_RELEASE_ALL = -1
 _INT32_MAX = np.iinfo(np.int32).max
+# CBLAS / LAPACKE enumerations (mkl_cblas.h, mkl_lapacke.h)
+_COL_MAJOR, _LEFT, _RIGHT, _LOWER, _NO_TRANS, _NON_UNIT = 102, 141, 142, 122, 111, 131
 
 
 def _candidate_paths() -> list[str]:
@@ -233,14 +235,24 @@ class MklPardiso:
             a[i1:, i0:i1] = a[i0:i1, i1:].T
         return a
 
-    def _lapacke_spd(self, name: str, uplo: bytes, a: np.ndarray) -> None:
+    def _lapacke_spd(
+        self,
+        name: str,
+        uplo: bytes,
+        a: np.ndarray,
+        n: int | None = None,
+        ptr: int | None = None,
+        lda: int | None = None,
+    ) -> None:
         """``LAPACKE_dpotrf`` / ``dpotri`` in place on the square C array ``a``, read
-        column-major (the transpose: the same matrix for an SPD one)."""
+        column-major (the transpose: the same matrix for an SPD one); or, given ``n``, ``ptr``
+        and ``lda``, on the ``n × n`` column-major block at address ``ptr`` inside ``a``."""
         fn = getattr(self.lib, name)
         fn.restype = ctypes.c_int
         fn.argtypes = [ctypes.c_int, ctypes.c_char, ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
-        n = a.shape[0]
-        info = fn(102, ctypes.c_char(uplo), n, a.ctypes.data, n)  # 102: column-major
+        if n is None:
+            n, ptr, lda = a.shape[0], a.ctypes.data, a.shape[0]
+        info = fn(_COL_MAJOR, ctypes.c_char(uplo), n, ptr, lda)
         if info > 0 and name == "LAPACKE_dpotrf":
             raise SolverError(f"matrix is not positive definite (leading minor {info})")
         if info != 0:
@@ -265,6 +277,90 @@ class MklPardiso:
             a[i0:i1, i0:i1] = np.tril(a[i0:i1, i0:i1])
             a[i0:i1, i1:] = 0.0
         return a
+
+    def spd_inverse_columns(self, S: np.ndarray, columns: np.ndarray) -> np.ndarray:
+        r"""The columns ``f = columns`` of ``S⁻¹`` for a dense SPD ``S`` (``m × m``, both
+        triangles filled), by MKL LAPACK and BLAS on one copy of ``S`` ordered ``[l, f]``
+        (``l`` the other rows).
+
+        The Cholesky factor of the reordered matrix holds every block the partial inverse needs
+        (Golub & Van Loan, *Matrix Computations*, 4th ed., §3.2 and §4.2):
+
+        .. math::
+
+            \begin{pmatrix} S_{ll} & S_{lf} \\ S_{fl} & S_{ff} \end{pmatrix}
+            = \begin{pmatrix} L_{ll} & 0 \\ W^T & L_{ff} \end{pmatrix}
+              \begin{pmatrix} L_{ll}^T & W \\ 0 & L_{ff}^T \end{pmatrix},
+            \qquad W = L_{ll}^{-1} S_{lf},\;
+            L_{ff} L_{ff}^T = S_{ff} - W^T W ,
+
+        so ``G_ff = (L_ff L_ffᵀ)⁻¹`` (``dpotri`` on the trailing block) and
+        ``G_lf = −L_ll⁻ᵀ W G_ff`` (``dsymm``, then ``dtrsm``): ``m³/3`` flops for ``dpotrf``
+        (one call: the ``W`` solve and the ``Wᵀ W`` update (a ``syrk``) inside it),
+        ``2 f³/3 + 2 l f² + l² f`` after it: the blocks of
+        :func:`fegear.linalg.schur.inverse_columns` without its separate ``f × f``
+        factorisation, with half of its ``Wᵀ W`` product, all in MKL (measured on the seed face
+        gear's pinion, ``m = 6591``, ``f = 2537``: 3.3 CPU s against 4.6 s for the same blocks
+        from SciPy's OpenBLAS and separate copies).
+
+        Parameters
+        ----------
+        S
+            ``(m, m)`` SPD, both triangles filled (only the lower one of the reordered copy is
+            read), not modified.
+        columns
+            ``(m,)`` bool, the columns ``f`` wanted; at least one, and at least one other.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(m, f)`` C-contiguous: ``(S⁻¹)[:, columns]``, rows in the order of ``S``.
+
+        Raises
+        ------
+        SolverError
+            ``S`` is not numerically positive definite, or LAPACK reports an error.
+        """
+        cols = np.asarray(columns, dtype=bool)
+        f_, l_ = np.flatnonzero(cols), np.flatnonzero(~cols)
+        m, f, l = S.shape[0], f_.size, l_.size
+        order = np.concatenate([l_, f_])
+        # The C array A read column-major is Aᵀ = A: LAPACK's lower triangle of it is the
+        # row-major upper one; every block below is addressed in that column-major layout.
+        A = np.ascontiguousarray(S[np.ix_(order, order)], dtype=np.float64)
+        self._lapacke_spd("LAPACKE_dpotrf", b"L", A)
+        base, item = A.ctypes.data, A.itemsize
+        trailing = base + (l + l * m) * item  # L_ff, then G_ff (column-major lower)
+        self._lapacke_spd("LAPACKE_dpotri", b"L", A, n=f, ptr=trailing, lda=m)
+        # Yᵀ = G_ff Wᵀ (f × l, column-major), Wᵀ at rows l.., columns ..l of the factor;
+        # a C array (l, f) is that column-major f × l array: Y = W G_ff itself
+        Y = np.empty((l, f))
+        self._blas("cblas_dsymm")(
+            _COL_MAJOR, _LEFT, _LOWER, f, l, 1.0, trailing, m, base + l * item, m, 0.0,
+            Y.ctypes.data, f,
+        )  # fmt: skip
+        # G_lfᵀ = −Yᵀ L_ll⁻¹ (in place): G_lf = −L_ll⁻ᵀ Y
+        self._blas("cblas_dtrsm")(
+            _COL_MAJOR, _RIGHT, _LOWER, _NO_TRANS, _NON_UNIT, f, l, -1.0, base, m,
+            Y.ctypes.data, f,
+        )  # fmt: skip
+        G = np.empty((m, f))
+        G_ff = A[l:, l:]  # row-major upper triangle = LAPACK's lower: mirror it
+        G[f_] = np.triu(G_ff) + np.triu(G_ff, 1).T
+        del A
+        G[l_] = Y
+        return G
+
+    def _blas(self, name: str):
+        """The CBLAS routine ``name`` of MKL (``cblas_dsymm`` or ``cblas_dtrsm``), typed."""
+        fn = getattr(self.lib, name)
+        fn.restype = None
+        i, d, p = ctypes.c_int, ctypes.c_double, ctypes.c_void_p
+        if name == "cblas_dsymm":  # layout, side, uplo, m, n, alpha, a, lda, b, ldb, beta, c, ldc
+            fn.argtypes = [i, i, i, i, i, d, p, i, p, i, d, p, i]
+        else:  # dtrsm: layout, side, uplo, trans, diag, m, n, alpha, a, lda, b, ldb
+            fn.argtypes = [i, i, i, i, i, i, i, d, p, i, p, i]
+        return fn
 
     def schur_spd(
         self, upper: sp.csr_matrix, schur_rows: np.ndarray, n_threads: int | None
