@@ -106,7 +106,8 @@ def run(
     root_stress
         Gear pairs at ``fe``/``hybrid``: compute the tooth root stress (the sectors remeshed
         with refined fillets and solved once more per member: on the seed face gear about
-        2 min and 5 GB more, ``benchmarks/results/root_stress_cost.md``); overrides ``[analysis] root_stress`` (default False).
+        2 min and 5 GB more, ``benchmarks/results/root_stress_cost.md``); overrides
+        ``[analysis] root_stress`` (default False).
     study
         Hertz scene: levels of a mesh-convergence study (overrides ``[study] levels``).
     progress

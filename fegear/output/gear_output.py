@@ -183,7 +183,11 @@ def write_gear_outputs(
         # and 2.6 s forked; the fork's copy-on-write pages nearly double the drawing's CPU).
         solves_side_by_side = pending and not run.case.root_stress
         fork = process_count(workers, 2) > 1 and kept is None and not solves_side_by_side
-        plots = apart(lambda r=run, res=result: loaded_plots(out, r, res), fork)
+        # the ease-off (a function of the pair and its assembly, which the cycle key holds) is
+        # drawn and kept with the pictures: a warm run copies it
+        plots = apart(
+            lambda r=run, res=result: loaded_plots(out, r, res) + write_ease_off(out, r), fork
+        )
         if pending:  # the fields while the pictures are drawn, then the model with them
             run = with_fields(run)
             result = build_result(run, views.pattern)
@@ -196,7 +200,7 @@ def write_gear_outputs(
             paths.append(plot_line_load(out, run))
     else:
         paths += tca_plots(out, run)
-    paths += write_ease_off(out, run)
+        paths += write_ease_off(out, run)
     files = [str(p.relative_to(out)) for p in paths] + ["summary.json"]
     # the summary last: its presence says the run is complete
     paths.append(write_json(out / "summary.json", summary_document(result, files)))

@@ -70,7 +70,8 @@ def kept_pictures(out: Path, params: dict[str, str] | None) -> list[Path] | None
 
 
 def keep_pictures(params: dict[str, str] | None, drawn: Sequence[Path]) -> None:
-    """Keep the pictures ``drawn`` (PNG files) under ``params`` (nothing for None)."""
+    """Keep the pictures ``drawn`` (the PNG files, and the ease-off's files drawn with them) under
+    ``params`` (nothing for None)."""
     if params is None:
         return
 
