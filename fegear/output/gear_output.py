@@ -183,11 +183,15 @@ def write_gear_outputs(
         # and 2.6 s forked; the fork's copy-on-write pages nearly double the drawing's CPU).
         solves_side_by_side = pending and not run.case.root_stress
         fork = process_count(workers, 2) > 1 and kept is None and not solves_side_by_side
-        # the ease-off (a function of the pair and its assembly, which the cycle key holds) is
-        # drawn and kept with the pictures: a warm run copies it
-        plots = apart(
-            lambda r=run, res=result: loaded_plots(out, r, res) + write_ease_off(out, r), fork
-        )
+
+        # the line-load chart of a cylindrical pair (the cycle's) and the ease-off (the pair's
+        # in its assembly, which the cycle key holds) are drawn and kept with the pictures: a
+        # warm run copies them
+        def draw(r=run, res=result) -> list[Path]:
+            line = [plot_line_load(out, r)] if is_cylindrical(r) else []
+            return loaded_plots(out, r, res) + line + write_ease_off(out, r)
+
+        plots = apart(draw, fork)
         if pending:  # the fields while the pictures are drawn, then the model with them
             run = with_fields(run)
             result = build_result(run, views.pattern)
@@ -196,8 +200,6 @@ def write_gear_outputs(
             kept = plots()
             keep_pictures(keep, kept)
         paths += kept
-        if is_cylindrical(run):
-            paths.append(plot_line_load(out, run))
     else:
         paths += tca_plots(out, run)
         paths += write_ease_off(out, run)
