@@ -274,9 +274,11 @@ def test_an_earlier_runs_outputs_are_replaced_and_other_files_refused(tmp_path, 
     err = capsys.readouterr().err
     assert f"{out}/: the 128 files of the previous run removed" in err, err
     names = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
-    assert names == [MANIFEST, "bearing_pattern.png", "summary.json", "te.png"], names
+    tca_files = ["bearing_pattern.png", "ease_off.json", "ease_off.png", "ease_off.vts",
+                 "summary.json", "te.png"]  # fmt: skip
+    assert names == [MANIFEST, *tca_files], names
     listed = (out / MANIFEST).read_text("utf-8").split("\n")[1:]
-    assert sorted(x for x in listed if x) == ["bearing_pattern.png", "summary.json", "te.png"]
+    assert sorted(x for x in listed if x) == tca_files
 
     mine = tmp_path / "mine"
     mine.mkdir()
@@ -343,7 +345,8 @@ def test_temporary_files_of_a_killed_write_are_removed_by_the_next_run(tmp_path,
     assert "2 temporary files of an interrupted run removed" in capsys.readouterr().err
     assert not list(out.rglob(".*tmp*")) and not (out / "vtk").exists()
     assert sorted(q.name for q in out.iterdir() if not q.name.startswith(".")) == [
-        "bearing_pattern.png", "summary.json", "te.png"]  # fmt: skip
+        "bearing_pattern.png", "ease_off.json", "ease_off.png", "ease_off.vts", "summary.json",
+        "te.png"]  # fmt: skip
 
     cache = tmp_path / "cache" / "sector_mesh"
     cache.mkdir(parents=True)

@@ -162,7 +162,8 @@ def test_case_file_reference_is_the_schema():
 
     rows = _case_table()
     expected = {
-        f"`[{sec.name}]`": set(sec.names) for sec in (gc.CASE, gc.LOAD, gc.ANALYSIS, gc.MATERIAL)
+        f"`[{sec.name}]`": set(sec.names)
+        for sec in (gc.CASE, gc.LOAD, gc.ANALYSIS, gc.MATERIAL, gc.TOPOGRAPHY)
     }
     for kind, sec in gc.PAIR_SECTIONS.items():
         expected[f"`[pair]`, kind `{kind}`"] = set(sec.names)
