@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import shutil
 import subprocess
 import sys
@@ -40,31 +39,8 @@ RESULTS = HERE / "results"
 NOMINAL = ROOT / "cases" / "face_gear_nominal.toml"
 FEGEAR = [sys.executable, "-m", "fegear.cli", "run", str(NOMINAL), "-q"]
 JOBS = {"plain": [], "root": ["--root-stress"]}
-
-
-def _machine() -> str:
-    """The CPU the figures were measured on (they scale with it; the ratios much less)."""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            names = [ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")]
-    except OSError:
-        names = []
-    return f"{os.cpu_count()} × {names[0] if names else 'unknown CPU'}"
-
-
-def _busy_cpu_s() -> float:
-    """CPU seconds all processes of the machine have used since boot (``/proc/stat``)."""
-    try:
-        with open("/proc/stat") as fh:
-            f = [int(x) for x in fh.readline().split()[1:9]]
-    except OSError:
-        return float("nan")
-    return (f[0] + f[1] + f[2] + f[5] + f[6] + f[7]) / os.sysconf("SC_CLK_TCK")
-
-
-def _children_cpu_s() -> float:
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
+sys.path.insert(0, str(HERE))
+from bench_error_study import _busy_cpu_s, _children_cpu_s, _machine  # noqa: E402
 
 
 def _one(extra: list[str], work: Path) -> dict:
