@@ -19,7 +19,10 @@ cold on 2 cores, the sector meshes and compliance operators are then cached).
 mesh/operator cache (:mod:`fegear.store.cache`: the per-user cache folder, or ``$FEGEAR_CACHE``);
 ``fegear plot FOLDER [--member gear|pinion]`` draws the bearing pattern over the cycle on a
 member's flank from a run's flank views. ``fegear export-ccx CASE`` writes the case as CalculiX
-decks (:mod:`fegear.export.command`).
+decks (:mod:`fegear.export.command`). ``fegear accept CASE [--design D] [--p-max-pct X]
+[--te-pp-arcsec X] [--khb X] [--allow-edge] [--out DIR]`` runs a measured case and its design
+and prints the checks and the verdict (:mod:`fegear.api.acceptance`); its exit code is the
+verdict's: 0 ACCEPT, 3 REJECT, 4 UNDECIDED (1 and 2 as for every command).
 
 The command is a layer over the Python API (:mod:`fegear.api`): ``fegear run`` is
 ``fegear.run(case, ...)`` then ``result.write(out)``, with the progress and the report printed.
@@ -176,6 +179,59 @@ def _parser() -> argparse.ArgumentParser:
                     help="whose flank (default: gear)")  # fmt: skip
     pl.add_argument("--png", help="the PNG (default: FOLDER/bearing_pattern_<member>_flank.png)")
     pl.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    a = sub.add_parser(
+        "accept",
+        help="is this batch acceptable: a measured case against its design, within tolerances",
+        description="Runs a measured case (a case file with a [topography] section) and its "
+        "design (the same case without [topography], or --design), compares p_max away from "
+        "the edges, the loaded and unloaded TE p-p, KHβ (cylindrical pairs) and edge contact "
+        "against the allowed increases, prints the checks and the verdict and writes "
+        "acceptance.json. Exit codes: 0 ACCEPT, 3 REJECT, 4 UNDECIDED (a headline not "
+        "reported by a run), 2 bad input, 1 the analysis failed.",
+    )
+    a.add_argument("case", help="the measured case file (TOML, with [topography])")
+    a.add_argument("--design", help="the design case file (default: CASE without [topography])")
+    a.add_argument(
+        "--p-max-pct",
+        metavar="X",
+        help="allowed increase of p_max away from the edges, %% (default 10)",
+    )
+    a.add_argument(
+        "--te-pp-arcsec",
+        metavar="X",
+        help="allowed increase of the loaded TE p-p, arcsec (default 1)",
+    )
+    a.add_argument(
+        "--te-pp-pct",
+        metavar="X",
+        help="allowed increase of the loaded TE p-p, %% (default: not checked)",
+    )
+    a.add_argument(
+        "--te-pp-unloaded-arcsec",
+        metavar="X",
+        help="allowed increase of the unloaded TE p-p, arcsec (default 1)",
+    )
+    a.add_argument(
+        "--khb", metavar="X", help="allowed increase of KHβ, cylindrical pairs (default 0.1)"
+    )
+    a.add_argument(
+        "--allow-edge",
+        action="store_true",
+        help="a loaded pair at a flank edge where the design has none does not reject",
+    )
+    a.add_argument(
+        "--fidelity",
+        help="hybrid (default: the case's) | fe | hertz | tca (unloaded: "
+        "the loaded checks are undecided)",
+    )
+    a.add_argument("--level", type=int, help="mesh level (0 = coarsest); overrides the cases")
+    a.add_argument("--workers", type=int, help="processes solving the mesh positions")
+    a.add_argument(
+        "--out",
+        default="out/acceptance",
+        help="folder of acceptance.json (default: ./out/acceptance)",
+    )
+    a.add_argument("-q", "--quiet", action="store_true", help="only the verdict line")
     add_export(sub)
     add_settings(sub)
     return p
@@ -568,6 +624,67 @@ def _sweep(args: argparse.Namespace) -> int:
     return 1 if res.n_failed else 0
 
 
+#: ``fegear accept`` option -> :class:`fegear.api.Tolerances` field
+_TOLERANCES = {
+    "--p-max-pct": "p_max_pct",
+    "--te-pp-arcsec": "te_pp_loaded_arcsec",
+    "--te-pp-pct": "te_pp_loaded_pct",
+    "--te-pp-unloaded-arcsec": "te_pp_unloaded_arcsec",
+    "--khb": "k_h_beta",
+}
+#: the exit codes of ``fegear accept`` by verdict (1 and 2 keep their meaning: failure, input)
+ACCEPT_EXIT = {"accept": 0, "reject": 3, "undecided": 4}
+
+
+def _accept(args: argparse.Namespace) -> int:
+    import math
+
+    from fegear.api import Tolerances, accept, load_case  # local: scipy (~2 s)
+    from fegear.io.gear_case import GearCase
+
+    given = {}
+    for option, name in _TOLERANCES.items():
+        text = getattr(args, option[2:].replace("-", "_"))
+        if text is None:
+            continue
+        try:
+            x = float(text)
+        except ValueError:
+            x = math.nan
+        if not (math.isfinite(x) and x >= 0):
+            raise InputError(option, text, "a finite number >= 0 (an allowed increase)")
+        given[name] = x
+    tol = Tolerances(**given, edge_contact_allowed=args.allow_edge)
+    check_writable_folder(args.out)
+    measured = load_case(args.case)
+    design = None if args.design is None else load_case(args.design)
+    for path, c in ((args.case, measured), (args.design, design)):
+        if c is not None and not isinstance(c, GearCase):
+            raise InputError("CASE" if path == args.case else "--design", path, "a gear case")
+    if design is None and not measured.topography:
+        raise InputError("--design", None, "a design case file for a case without [topography]",
+                         "it would be compared with itself")  # fmt: skip
+    say = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    t_start = time.perf_counter()
+
+    def progress(which: str, case) -> None:
+        k = 1 if which == "measured" else 2
+        say(f"[{k}/2] {which}: {case.name} ({case.source}) ...  "
+            f"({time.perf_counter() - t_start:.1f} s elapsed)")  # fmt: skip
+
+    try:
+        verdict = accept(measured, tol, design, fidelity=args.fidelity, level=args.level,
+                         workers=args.workers, progress=progress)  # fmt: skip
+    except InputError as exc:
+        if exc.field == "design_case":
+            raise InputError("--design", exc.value, exc.allowed, exc.detail) from exc
+        raise _as_option(exc) from exc
+    path = verdict.write(args.out)
+    say(f"wrote {path} in {time.perf_counter() - t_start:.1f} s")
+    print(verdict.line if args.quiet else verdict.table())
+    return ACCEPT_EXIT[verdict.verdict]
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 2 bad input, 1 other failure)."""
     args = _parser().parse_args(argv)
@@ -576,7 +693,7 @@ def main(argv: list[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
-        if args.command in ("run", "sweep", "export-ccx", "settings"):
+        if args.command in ("run", "sweep", "export-ccx", "settings", "accept"):
             check_cache_root()  # an unusable FEGEAR_CACHE is refused before any work
         if args.command == "run":
             return _run(args)
@@ -584,6 +701,8 @@ def main(argv: list[str] | None = None) -> int:
             return _sweep(args)
         if args.command == "cache":
             return _cache(args)
+        if args.command == "accept":
+            return _accept(args)
         if args.command == "plot":
             return _plot(args)
         if args.command == "export-ccx":

@@ -19,9 +19,12 @@ which writes the files ``fegear run`` writes (the command is a layer over this m
 are in the names (mm, N, MPa, N·m, arcsec, deg).
 
 For scripts that compare runs (one per installation error, say): :func:`table` (a text table of
-the headline numbers and the pattern shift), :func:`plot_te` and :func:`plot_patterns`.
+the headline numbers and the pattern shift), :func:`plot_te` and :func:`plot_patterns`. Is a
+measured batch acceptable: :func:`accept` (a measured run against its design, within the user's
+:class:`Tolerances`).
 """
 
+from fegear.api.acceptance import Check, Tolerances, Verdict, accept
 from fegear.api.compare import plot_patterns, plot_te, table
 from fegear.api.gear_result import GearResult
 from fegear.api.hertz_scene_result import HertzResult
@@ -30,6 +33,7 @@ from fegear.api.settings import machine_sheet, machine_tables
 from fegear.results.model import Checks, Cycle, Excluded, PairLoad, Position
 
 __all__ = [
+    "Check",
     "Checks",
     "Cycle",
     "Excluded",
@@ -38,6 +42,9 @@ __all__ = [
     "PairLoad",
     "Position",
     "Progress",
+    "Tolerances",
+    "Verdict",
+    "accept",
     "load_case",
     "machine_sheet",
     "machine_tables",
