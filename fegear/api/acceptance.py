@@ -174,8 +174,9 @@ class Verdict:
         line."""
         m, d = self.measured, self.design
         head = (
-            f"{m.case.name} ({m.case.source}) against its design {d.case.name} "
-            f"({d.case.source}{', without [topography]' if not d.case.topography else ''}): "
+            f"{m.case.name} ({_where(m.case.source)}) against its design {d.case.name} "
+            f"({_where(d.case.source)}"
+            f"{', without [topography]' if not d.case.topography else ''}): "
             f"{m.fidelity}" + (f" level {m.level}" if m.level is not None else "")
             + f", {m.cycle.n_positions} positions"
         )  # fmt: skip
@@ -194,7 +195,8 @@ class Verdict:
 
         def run(r: GearResult) -> dict[str, Any]:
             return {"case": r.case.name, "source": str(r.case.source),
-                    "topography": dict(r.case.topography), "fidelity": r.fidelity,
+                    "topography": {k: {"file": str(g.path), "sha256": g.sha256}
+                                   for k, g in r.case.topography.items()}, "fidelity": r.fidelity,
                     "level": r.level, "n_positions": r.cycle.n_positions}  # fmt: skip
 
         return {
@@ -211,6 +213,14 @@ class Verdict:
     def write(self, folder: str | Path) -> Path:
         """Write ``acceptance.json`` into ``folder`` (made if missing), atomically; its path."""
         return write_json(Path(folder) / "acceptance.json", self.as_dict())
+
+
+def _where(source: object) -> str:
+    """A case's file relative to the working folder when it is under it (the table's head)."""
+    try:
+        return str(Path(str(source)).resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(source)
 
 
 #: the checks' names in the verdict line
