@@ -17,7 +17,7 @@ an edge against 16).
 - ``the defaults`` (p_max +10 %, TE p-p +1″, KHβ +0.1, no new edge contact): **REJECT**:
   p_max, the loaded TE p-p and KHβ fail; the unloaded TE and the edge contact pass;
 - ``a noise spec`` (a customer who buys the pair for its TE, with strength margin to spare:
-  p_max +20 %, KHβ +0.7, TE p-p loaded +2″ and +10 %, unloaded +0.5″): **ACCEPT**, every check
+  p_max +25 %, KHβ +0.7, TE p-p loaded +2″ and +10 %, unloaded +0.5″): **ACCEPT**, every check
   within its limit.
 
     python cases/helical_measured_acceptance.py [FIDELITY]   # default: the case's (hybrid)
@@ -35,7 +35,7 @@ CASE = Path(__file__).with_name("helical_measured.toml")
 SPECS = {
     "the defaults": Tolerances(),
     "a noise spec": Tolerances(
-        p_max_pct=20.0,
+        p_max_pct=25.0,
         k_h_beta=0.7,
         te_pp_loaded_arcsec=2.0,
         te_pp_loaded_pct=10.0,
