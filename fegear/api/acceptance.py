@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from fegear.api.gear_result import GearResult
+from fegear.api.runner import run
 from fegear.errors import InputError
 from fegear.io.gear_case import GearCase
 from fegear.store.files import write_json
@@ -392,8 +393,6 @@ def accept(
         ``design_case``); a design of another kind of pair or other positions; bad tolerances
         or run options.
     """
-    from fegear.api.runner import run  # local: the pipeline (scipy, scikit-fem)
-
     tol = Tolerances() if tolerances is None else tolerances
     if not isinstance(tol, Tolerances):
         raise InputError("tolerances", type(tol).__name__, "a fegear.Tolerances")
