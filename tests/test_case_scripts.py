@@ -149,6 +149,13 @@ def check_helical_crowning_sweep(results, out):
     assert (out / "crowning.png").read_bytes()[:8] == PNG
 
 
+def check_helical_measured_acceptance(verdicts, out):
+    # the crowning gathers the load: rejected under the defaults on p_max and KHβ, accepted
+    # under the noise spec (tests/test_acceptance.py runs the script at 5 positions)
+    assert [v.verdict for v in verdicts.values()] == ["reject", "accept"]
+    assert {c.name for c in verdicts["the defaults"].failing} >= {"p_max", "k_h_beta"}
+
+
 CHECKS = {
     "face_gear_dE": check_face_gear_dE,
     "face_gear_dA1": check_face_gear_dA1,
@@ -156,6 +163,7 @@ CHECKS = {
     "face_gear_dgamma": check_face_gear_dgamma,
     "spiral_bevel_vh": check_spiral_bevel_vh,
     "helical_crowning_sweep": check_helical_crowning_sweep,
+    "helical_measured_acceptance": check_helical_measured_acceptance,
 }
 
 
