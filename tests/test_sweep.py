@@ -495,3 +495,35 @@ def test_items_side_by_side_mesh_their_own_members(fzg3, tmp_path, monkeypatch):
     fegear.mesh.gmsh_session.started_here); every item finishes, each built its two meshes."""
     for use in _two_worker_sweep(fzg3, tmp_path, monkeypatch, "pair.module_mm=4.5,4.6,4.7"):
         assert use["built"].get("mesh") == 2, use
+
+
+def test_a_sweep_over_measured_flank_grids_runs_each_into_its_own_folder(tmp_path):
+    """A tolerance study over measured grids: ``--grid topography.pinion_drive=...`` with a grid
+    named relative to the case file and one by an absolute path; each item is the case with that
+    grid (at ``tca``: the unloaded TE of the 10 µm crowning against a zero grid) in a folder of
+    its own (the path's separators are not folder separators in the item's name)."""
+    case = Path(__file__).resolve().parents[1] / "cases" / "helical_measured.toml"
+    crowned = (case.parent / "helical_measured_pinion_drive.csv").read_text(encoding="utf-8")
+    rows = [ln for ln in crowned.splitlines() if ln.strip() and not ln.startswith("#")]
+    zero = tmp_path / "grids" / "zero.csv"
+    zero.parent.mkdir()
+    zero.write_text(
+        "\n".join([rows[0]] + [r.split(",")[0] + ",0" * (len(r.split(",")) - 1) for r in rows[1:]])
+        + "\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "sweep"
+    grid = f"topography.pinion_drive=helical_measured_pinion_drive.csv,{zero}"
+    assert main(["sweep", str(case), "--grid", grid, "--fidelity", "tca", "--out", str(out),
+                 "-q", "--workers", "1"]) == 0  # fmt: skip
+    doc = json.loads((out / "sweep.json").read_text())
+    assert doc["status"]["done"] == 2 and doc["status"]["failed"] == 0
+    names = [it["name"] for it in doc["items"]]
+    assert all("/" not in n and (out / n / "summary.json").is_file() for n in names), names
+    shas = [
+        json.loads((out / n / "summary.json").read_text())["inputs"]["topography"]["pinion_drive"][
+            "sha256"
+        ]
+        for n in names
+    ]
+    assert len(set(shas)) == 2  # each item ran with its own grid

@@ -45,6 +45,7 @@ import itertools
 import logging
 import math
 import os
+import re
 import shutil
 import time
 import tomllib
@@ -290,7 +291,12 @@ def _read_toml(path: Path) -> dict[str, Any]:
 
 
 def _fmt(v: Value) -> str:
-    return f"{v:g}" if isinstance(v, float) else str(v)
+    """A value as it appears in an item's name (its folder): a number as ``%g``; text with every
+    character outside ``A-Z a-z 0-9 . _ + -`` as ``_`` (a swept file path, e.g. a
+    ``topography.pinion_drive`` grid, holds separators)."""
+    if isinstance(v, float):
+        return f"{v:g}"
+    return re.sub(r"[^A-Za-z0-9._+-]", "_", str(v))
 
 
 def _check_overrides(fidelity: str | None, level: int | None) -> None:
