@@ -110,6 +110,20 @@ def test_grid_sweep_writes_items_and_sweep_outputs(grid_sweep):
     print(f"grid sweep of 3 items: {seconds:.1f} s")
 
 
+def test_the_sweep_reports_the_spread_of_its_headlines(grid_sweep):
+    """A tolerance study's answer: min / median / max of each key result over the items (here
+    the FZG axis tilted −0.01, 0, +0.01 mm), the exact extremes and middle of the items' own
+    values, and the table in comparison.md."""
+    _, out, _, _ = grid_sweep
+    doc = json.loads((out / "sweep.json").read_text())
+    for key, v in doc["spread"].items():
+        vals = sorted(it["results"][key] for it in doc["items"])
+        assert (v["n"], v["null"]) == (3, 0), key
+        assert [v["min"], v["median"], v["max"]] == vals, key  # 3 items: the middle one
+    md = (out / "comparison.md").read_text()
+    assert "| p_max away from the edges (MPa) |" in md and "Spread over the 3 finished items" in md
+
+
 def test_rerun_skips_finished_items(grid_sweep, capsys):
     code, out, argv, _ = grid_sweep
     assert code == 0

@@ -8,7 +8,10 @@ outputs are written into ``<out>/`` (each atomically), from the items' ``summary
   ``contact_ratio_loaded``, ``p_max_MPa``, ``pattern_position_mm`` and its extent), and the
   comparison against the nominal item. Rewritten after every item, so it tells the state of an
   interrupted sweep too.
-- ``comparison.md`` — the comparison table (Markdown).
+  With ``spread``: per key result its minimum, median and maximum over the finished items that
+  have it and the count of those that do not (a tolerance study: the spread of the headlines
+  over installation errors or measured flank grids, ``docs/measured_flanks.md``).
+- ``comparison.md`` — the comparison table and the spread (Markdown).
 - ``te_overlay.png`` — the TE curves of all finished items on one figure (unloaded and loaded).
 
 Pattern position (mm), the mean of the pairs' contact points over the cycle (weighted by the pair
@@ -229,6 +232,34 @@ def _collect(out: Path, items: Sequence, results: Mapping) -> tuple[dict, dict]:
     return docs, keyres
 
 
+#: the key results whose spread a sweep reports, with their labels and formats
+SPREAD = {
+    "te_pp_unloaded_arcsec": ("TE p-p unloaded (arcsec)", ".3f"),
+    "te_pp_loaded_arcsec": ("TE p-p loaded (arcsec)", ".3f"),
+    "contact_ratio_loaded": ("contact ratio loaded", ".3f"),
+    "p_max_MPa": ("p_max away from the edges (MPa)", ".0f"),
+    "pattern_position_mm": ("pattern position (mm)", ".3f"),
+}
+
+
+def spread(keyres: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+    """Per key result of :data:`SPREAD`: ``min``, ``median``, ``max`` over the items of
+    ``keyres`` that have it (``None`` when none has), ``n`` those items, ``null`` the others
+    (a value a run could not report: counted, never taken as a number)."""
+    out = {}
+    for key in SPREAD:
+        vals = [k[key] for k in keyres.values() if k.get(key) is not None]
+        a = np.asarray(vals, dtype=float)
+        out[key] = {
+            "n": len(vals),
+            "null": len(keyres) - len(vals),
+            "min": float(a.min()) if vals else None,
+            "median": float(np.median(a)) if vals else None,
+            "max": float(a.max()) if vals else None,
+        }
+    return out
+
+
 def _document(
     out: Path, items: Sequence, results: Mapping, meta: Mapping[str, Any]
 ) -> tuple[dict[str, Any], dict, dict]:
@@ -266,6 +297,7 @@ def _document(
         "units": {"te": "arcsec", "pressure": "MPa", "length": "mm"},
         "items": rows,
         "comparison": comparison(items, keyres, meta.get("nominal")),
+        "spread": spread(keyres),
     }
     return doc, docs, keyres
 
@@ -322,6 +354,22 @@ def _markdown(doc: dict[str, Any]) -> str:
             )
             + " |"
         )
+    sp = doc.get("spread") or {}
+    if any(v["n"] for v in sp.values()):
+        lines += [
+            "",
+            f"Spread over the {len(cmp['rows'])} finished items (a value a run could not report "
+            "is counted, not taken):",
+            "",
+            "| result | min | median | max | items | null |",
+            "|---|---:|---:|---:|---:|---:|",
+        ]
+        for key, (label, fmt) in SPREAD.items():
+            v = sp[key]
+            lines.append(
+                f"| {label} | {_num(v['min'], fmt)} | {_num(v['median'], fmt)} | "
+                f"{_num(v['max'], fmt)} | {v['n']} | {v['null']} |"
+            )
     return "\n".join(lines) + "\n"
 
 
