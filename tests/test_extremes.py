@@ -190,7 +190,9 @@ _STUCK = textwrap.dedent(
     import fegear.ltca.cycle as cycle
 
     def stuck(r, job=None):  # a position that takes forever (the workers are the real pool's)
-        print(f"worker {os.getpid()}", flush=True)
+        # one write() of a whole line: atomic on a pipe (print's may split, and the two workers'
+        # lines then interleave)
+        os.write(1, f"worker {os.getpid()}\n".encode())
         time.sleep(600)
 
     cycle._solve_chunk = stuck
