@@ -192,7 +192,7 @@ _STUCK = textwrap.dedent(
     def stuck(r, job=None):  # a position that takes forever (the workers are the real pool's)
         # one write() of a whole line: atomic on a pipe (print's may split, and the two workers'
         # lines then interleave)
-        os.write(1, f"worker {os.getpid()}\n".encode())
+        os.write(1, f"worker {os.getpid()}\\n".encode())
         time.sleep(600)
 
     cycle._solve_chunk = stuck
