@@ -187,14 +187,22 @@ def test_hertz_scene_calculix_against_hertz(tmp_path):
     peak pressure is Hertz's within the scatter of meshes this coarse."""
     case = load_case(CASES / "hertz_scene.toml")
     inp = export_ccx(case, tmp_path, element_mm=COARSE_MM)[0]
-    run = run_ccx(inp, threads=2, timeout_s=600)
+    run = run_ccx(inp, threads=1, timeout_s=600)
     assert run.returncode == 0, (tmp_path / (inp.stem + ".log")).read_text()[-2000:]
     res = read_results(inp)
     ref = hertz_reference(case.scene)
+    (pair,) = res.pairs
+    # the pressure at CalculiX's integration points times their areas is the contact force:
+    # 2 %, the cross-check's bound (the print's 7 digits give 2e-5: measured 1.9e-5)
+    assert pair.ip_force_N == pytest.approx(pair.normal_force_N, rel=0.02)
+    stats, _ = read_dat(inp.with_suffix(".dat"))
+    assert pair.contact_area_mm2 == pytest.approx(stats[("S_BLOCK_ZONE", "S_ROLLER_ZONE")]["area"],
+                                                  rel=1e-4)  # fmt: skip
+    # CalculiX's nodal pressures (a fit per face to its active points) integrate to more
+    assert pair.nodal_force_N > 1.1 * pair.normal_force_N
     # equilibrium of the converged increment: CalculiX's force-residual criterion is 0.5 % of
     # the mean nodal force (its default), far tighter on the total
     assert res.balance == pytest.approx(1.0, abs=5e-3)
-    (pair,) = res.pairs
     assert pair.normal_force_N == pytest.approx(case.scene.force_N / 4, rel=5e-3)
     # the largest nodal pressure against p0: one element per semi-minor axis; the measured
     # ladder (docs/calculix.md) scatters by a few % at these sizes, 8 % bounds it
@@ -234,3 +242,115 @@ def test_fzg_two_pair_load_shares_against_fegear(tmp_path):
     # the lag (loaded TE − unloaded TE): 5 %, the issue's bound on the loaded TE
     assert res.theta_rad == pytest.approx(cyc.positions[0].theta, rel=0.05)
     json.dumps(res.to_dict())  # the result is JSON-able
+
+
+def _tri6_grid(nx: int, ny: int, lx: float, ly: float, lift=None):
+    """Six-node triangles over ``[0, lx] × [0, ly]`` (``2 nx ny`` faces: corners, then the
+    mid-edge nodes 1-2, 2-3, 3-1), the nodes at ``z = lift(x, y)`` (flat without it)."""
+    xs, ys = np.linspace(0.0, lx, 2 * nx + 1), np.linspace(0.0, ly, 2 * ny + 1)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    Z = np.zeros_like(X) if lift is None else lift(X, Y)
+    xyz = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+
+    def n(i, j):
+        return i * (2 * ny + 1) + j
+
+    faces = []
+    for i in range(0, 2 * nx, 2):
+        for j in range(0, 2 * ny, 2):
+            faces.append([n(i, j), n(i + 2, j), n(i + 2, j + 2),
+                          n(i + 1, j), n(i + 2, j + 1), n(i + 1, j + 1)])  # fmt: skip
+            faces.append([n(i, j), n(i + 2, j + 2), n(i, j + 2),
+                          n(i + 1, j + 1), n(i + 1, j + 2), n(i, j + 1)])  # fmt: skip
+    return np.array(faces), xyz
+
+
+@pytest.mark.parametrize(
+    ("field", "exact"),
+    [
+        (lambda x, y: np.full_like(x, 3.0), 3.0 * 2.0 * 1.5),
+        (lambda x, y: 1.0 + 2.0 * x - y, 2.0 * 1.5 * (1.0 + 2.0 - 0.75)),
+        # ∫∫ x² + x y + y² over [0, 2] × [0, 1.5] = (8/3) 1.5 + (2)(1.125) + 2 (1.125)
+        (lambda x, y: x * x + x * y + y * y, 8.0 / 3.0 * 1.5 + 2.0 * 1.125 + 2.0 * 1.125),
+    ],
+)
+def test_face_integral_is_exact_for_quadratic_fields_on_flat_faces(field, exact):
+    """The six-node face integral (``face_integral``): a constant, linear and quadratic
+    pressure over flat faces integrate exactly (the 7-point rule is of degree 5), and the
+    corner nodes carry no weight (``∫ N_corner dA = 0``)."""
+    from fegear.export.ccx_results import face_integral
+
+    faces, xyz = _tri6_grid(3, 2, 2.0, 1.5)
+    v = field(xyz[:, 0], xyz[:, 1])
+    assert face_integral(faces, xyz, v).sum() == pytest.approx(exact, rel=1e-12)
+    corners = np.zeros(len(xyz))
+    corners[np.unique(faces[:, :3])] = 1.0
+    assert face_integral(faces, xyz, corners).sum() == pytest.approx(0.0, abs=1e-12)
+
+
+def test_face_integral_follows_curved_faces():
+    """On a cylinder of radius 5 mm (the nodes on it, the faces quadratic), a unit pressure
+    integrates to the cylinder's area within the quadratic geometry's O(h⁴) error."""
+    from fegear.export.ccx_results import face_integral
+
+    R, phi, L = 5.0, 0.8, 2.0
+    faces, xyz = _tri6_grid(4, 2, phi, L)
+    pts = np.column_stack([R * np.sin(xyz[:, 0]), xyz[:, 1], R * np.cos(xyz[:, 0])])
+    total = face_integral(faces, pts, np.ones(len(pts))).sum()
+    assert total == pytest.approx(R * phi * L, rel=1e-5)
+
+
+#: ``*CONTACT PRINT`` blocks of face-to-face contact as CalculiX 2.20 writes them (its energy
+#: header reads "contact print energy (...)for all"); the load step's at time 2.
+_POINTS_DAT = """
+ contact stress (slave element+face,press,tang1,tang2) for all contact elements and time \
+0.2000000E+01
+
+         7          1  1.000000E+03  0.000000E+00  0.000000E+00
+         7          1  5.000000E+02  0.000000E+00  0.000000E+00
+         9          3  2.000000E+03  0.000000E+00  0.000000E+00
+
+ relative contact displacement (slave element+face,normal,tang1,tang2) for all contact \
+elements and time 0.2000000E+01
+
+         7          1 -1.000000E-04  0.000000E+00  0.000000E+00
+         7          1 -5.000000E-05  0.000000E+00  0.000000E+00
+         9          3 -2.000000E-04  0.000000E+00  0.000000E+00
+
+ contact print energy (slave element+face,energy)for all contact elements and time 0.2000000E+01
+
+         7          1  5.000000E-04
+         7          1  2.500000E-04
+         9          3  4.000000E-03
+"""
+
+
+def test_contact_points_reader_recovers_each_points_area(tmp_path):
+    """The integration points' print: the pressure, overclosure and spring energy of each
+    contact element; the area each point stands for, ``2 K E / p²``, makes the force
+    ``Σ p A``; a face's force goes to its nodes whole (``_spread``)."""
+    from fegear.export.ccx_results import _face_points, _lumped, _spread, read_dat_points
+
+    (tmp_path / "j.dat").write_text(_POINTS_DAT)
+    pts = read_dat_points(tmp_path / "j.dat")
+    assert pts is not None and pts.time == 2.0
+    assert pts.element.tolist() == [7, 7, 9] and pts.face.tolist() == [1, 1, 3]
+    K = 1.0e7  # MPa/mm: p = K × overclosure in the rows above
+    np.testing.assert_allclose(pts.pressure, -K * pts.overclosure)
+    a = pts.areas(K)  # E = A p² / (2 K)
+    np.testing.assert_allclose(a, [0.01, 0.02, 0.02])
+    force, area, pmax, n = _face_points(pts, [[9, 3], [7, 1], [8, 2]], K)
+    np.testing.assert_allclose(force, [40.0, 20.0, 0.0])
+    np.testing.assert_allclose(area, [0.02, 0.03, 0.0])
+    assert pmax.tolist() == [2000.0, 1000.0, 0.0] and n == 3
+    # spreading: the nodal forces sum to each face's force, also where the nodal field is 0
+    faces, xyz = _tri6_grid(1, 1, 1.0, 1.0)
+    p_nodes = np.where(xyz[:, 0] > 0.5, 1.0, 0.0)
+    f = _spread(faces, xyz, p_nodes, np.array([40.0, 20.0]))
+    assert f.sum() == pytest.approx(60.0)
+    assert np.all(f[p_nodes == 0.0] == 0.0)  # the force goes where CalculiX's pressure is
+    assert _lumped(faces, xyz).sum() == pytest.approx(1.0)
+    f = _spread(faces, xyz, np.zeros(len(xyz)), np.array([40.0, 20.0]))
+    assert f.sum() == pytest.approx(60.0) and np.all(f > 0.0)  # by area without a nodal field
+    (tmp_path / "none.dat").write_text("")
+    assert read_dat_points(tmp_path / "none.dat") is None

@@ -98,6 +98,11 @@ def run(args: argparse.Namespace) -> int:
             say(f"    pair ({q.k}, {q.j}): share {q.load_share:.4f}, force {q.normal_force_N:.1f}"
                 f" N, p_max {q.p_max_MPa:.0f} MPa (recovered {q.p_peak_MPa:.0f}), semi-axes "
                 f"{q.semi_major_mm:.3f} x {q.semi_minor_mm:.3f} mm")  # fmt: skip
+            if q.ip_force_N is not None and q.normal_force_N > 0:
+                say(f"      pressure integral / contact force {q.ip_force_N / q.normal_force_N:.5f}"
+                    f" ({q.n_points} integration points, contact area "
+                    f"{q.contact_area_mm2:.4g} mm2); CalculiX's nodal pressures integrate to "
+                    f"{q.nodal_force_N / q.normal_force_N:.3f} x the force")  # fmt: skip
         if res.te_loaded_arcsec is not None:
             say(f"    TE unloaded {res.te_unloaded_arcsec:.2f}, loaded {res.te_loaded_arcsec:.2f}"
                 f" arcsec (lag {res.theta_rad:.4g} rad)")  # fmt: skip

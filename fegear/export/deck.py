@@ -31,10 +31,33 @@ import numpy as np
 from fegear.errors import InputError
 from fegear.store.files import atomic_write
 
-__all__ = ["Deck", "DEFAULT_PENALTY_E", "boundary_lines", "nset_lines", "contact_cards"]
+__all__ = [
+    "Deck",
+    "DEFAULT_PENALTY_E",
+    "IP_PRINT",
+    "boundary_lines",
+    "nset_lines",
+    "contact_cards",
+    "element_sides",
+]
 
 #: Default penalty slope in Young's moduli per mm (CalculiX's default for node-to-face penalty).
 DEFAULT_PENALTY_E = 50.0
+
+#: The contact values at the slave faces' integration points, printed to the ``.dat`` (one row
+#: per active integration point of face-to-face penalty contact: slave element, face, values;
+#: CalculiX manual, ``*CONTACT PRINT``): the pressure (``CSTR``), the overclosure (``CDIS``) and
+#: the spring energy (``CELS``), from which the reader recovers each point's area
+#: (:mod:`fegear.export.ccx_results`). Without ``SLAVE``/``MASTER``: all contact elements.
+IP_PRINT = "*CONTACT PRINT\nCSTR, CDIS, CELS\n"
+
+
+def element_sides(body, surface: str, element_offset: int) -> list[list[int]]:
+    """``[[element, face], ...]`` of a body's surface as the deck numbers them (1-based elements
+    after ``element_offset``; faces 1-4), in the order of its six-node faces
+    (:meth:`fegear.export.inp.Tet10Body.face_triangles`)."""
+    f = np.asarray(body.faces[surface], dtype=np.int64)
+    return np.column_stack([f[:, 0] + 1 + element_offset, f[:, 1]]).tolist()
 
 
 @dataclass(frozen=True)

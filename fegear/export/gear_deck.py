@@ -42,9 +42,11 @@ import numpy as np
 from fegear.errors import InputError
 from fegear.export.deck import (
     DEFAULT_PENALTY_E,
+    IP_PRINT,
     Deck,
     boundary_lines,
     contact_cards,
+    element_sides,
     material_cards,
     nset_lines,
 )
@@ -209,12 +211,13 @@ def gear_deck(
     rim = gear.face_nodes("support") + 1 + n1
     out.write(nset_lines("GEAR_RIM", rim))
     out.write(f"*RIGID BODY, NSET=GEAR_RIM, REF NODE={rp}, ROT NODE={rot}\n")
-    pairs, slave_faces, edge_nodes = [], {}, {}
+    pairs, slave_faces, slave_sides, edge_nodes = [], {}, {}, {}
     for k, j in here.pairs:
         k, j = int(k), int(j)
         s, m = f"S_pinion_zone_{k + c}", f"S_gear_zone_{j + c}"
         pairs.append({"k": k, "j": j, "slave": s, "master": m})
         slave_faces[s] = (pin.face_triangles(f"zone_{k + c}") + 1).tolist()
+        slave_sides[s] = element_sides(pin, f"zone_{k + c}", 0)
         # the borders of both working flanks: a patch reaching one is an edge contact
         edge_nodes[s] = np.concatenate(
             [pin.border_nodes(f"flank_{k + c}") + 1, gear.border_nodes(f"flank_{j + c}") + 1 + n1]
@@ -223,6 +226,7 @@ def gear_deck(
     fixed = [("PINION_HELD", 1, 3, None), ("RP_GEAR", 1, 3, None), ("ROT_GEAR", 1, 2, None)]
     out.write("*STEP\n*STATIC\n")
     out.write(boundary_lines(fixed + [("ROT_GEAR", 3, 3, -s2 * theta_pre)], op_new=False))
+    out.write(IP_PRINT)  # CalculiX: energy output (CELS) must start in the first step
     out.write("*END STEP\n")
     out.write("*STEP, INC=200\n*STATIC\n1.0, 1.0, 1e-05, 1.0\n")
     out.write(boundary_lines(fixed, op_new=True))
@@ -231,6 +235,7 @@ def gear_deck(
     out.write("*NODE FILE\nU\n")
     for p in pairs:
         out.write(f"*CONTACT PRINT, SLAVE={p['slave']}, MASTER={p['master']}\nCF\n")
+    out.write(IP_PRINT)
     out.write("*CONTACT FILE\nCDIS, CSTR\n")
     out.write("*END STEP\n")
     # pairs left out of the contact pairs: their angular separation (a lag beyond it closes them)
@@ -257,6 +262,7 @@ def gear_deck(
         "preload_rad": theta_pre,
         "pairs": pairs,
         "slave_faces": slave_faces,
+        "slave_sides": slave_sides,
         "edge_nodes": edge_nodes,
         "lever_max_mm": lever,
         "left_out": left,

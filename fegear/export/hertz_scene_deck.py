@@ -25,9 +25,11 @@ import numpy as np
 from fegear.errors import InputError
 from fegear.export.deck import (
     DEFAULT_PENALTY_E,
+    IP_PRINT,
     Deck,
     boundary_lines,
     contact_cards,
+    element_sides,
     material_cards,
     nset_lines,
 )
@@ -167,6 +169,7 @@ def hertz_deck(
     pre = PRELOAD_APPROACH * ref.approach_mm
     out.write("*STEP\n*STATIC\n")
     out.write(boundary_lines(fixed + [("RP_AXLE", 3, 3, -pre)], op_new=False))
+    out.write(IP_PRINT)  # CalculiX: energy output (CELS) must start in the first step
     out.write("*END STEP\n")
     force = scene.force_N * fraction
     out.write("*STEP, INC=200\n*STATIC\n1.0, 1.0, 1e-05, 1.0\n")
@@ -174,6 +177,7 @@ def hertz_deck(
     out.write(f"*CLOAD\nRP_AXLE, 3, {-force:.12g}\n")
     out.write("*NODE PRINT, NSET=RP_AXLE\nU\n")
     out.write(f"*CONTACT PRINT, SLAVE={slave}, MASTER={master}\nCF\n")
+    out.write(IP_PRINT)
     out.write("*CONTACT FILE, FREQUENCY=1000\nCDIS, CSTR\n")
     out.write("*END STEP\n")
     record = {
@@ -187,6 +191,7 @@ def hertz_deck(
         "preload_mm": pre,
         "pairs": [{"slave": slave, "master": master, "name": "roller-block"}],
         "slave_faces": {slave: (block.face_triangles("zone") + 1).tolist()},
+        "slave_sides": {slave: element_sides(block, "zone", 0)},
         "ref_nodes": {"RP_AXLE": rp},
         "zone": {"x_mm": reach_x, "y_mm": reach_y},
         "n_nodes": n_nodes,
