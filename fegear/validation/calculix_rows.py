@@ -103,11 +103,17 @@ def _ccx_interior(r: Mapping) -> dict:
 
 
 def _pressure_integral(r: Mapping) -> dict:
-    """Per pair of a CalculiX row: its nodal pressures integrated over their tributary areas
-    over its contact force (1 where the pressure field is resolved); absent where not read."""
-    return {(p["k"], p["j"]): p["nodal_force_N"] / p["normal_force_N"]
-            for p in r["result"]["pairs"]
-            if p.get("nodal_force_N") and p.get("normal_force_N")}  # fmt: skip
+    """Per pair of a CalculiX row: the integral of the pressure it was read with over its
+    contact force; absent where not read. Rows read from the integration points
+    (``ip_force_N``, :mod:`fegear.export.ccx_results`) integrate their points' pressure
+    (1 within the print's digits); older rows the nodal ``CPRESS`` over tributary areas
+    (``nodal_force_N``: above 1 where faces are partly in contact)."""
+    out = {}
+    for p in r["result"]["pairs"]:
+        f = p.get("ip_force_N") or p.get("nodal_force_N")
+        if f and p.get("normal_force_N"):
+            out[(p["k"], p["j"])] = f / p["normal_force_N"]
+    return out
 
 
 def _loaded(shares: Mapping, floor: float = 0.05) -> int:
@@ -435,8 +441,9 @@ def criteria(doc: Mapping) -> list[dict]:
     loaded TE's also ``"extrapolation"``, :class:`Extrapolation`, when CalculiX's ladder gives
     one: then ``value`` is against the extrapolated TE and ``ccx_moves`` is its GCI; else
     ``"not_extrapolated"``: True when three sizes or more did not give one: not decided; the
-    p_max checks' ``"pressure_integral"``: CalculiX's nodal pressures integrated over the pair's
-    contact force, not decided when it is off 1 by more than the bound);
+    p_max checks' ``"pressure_integral"``: CalculiX's pressures integrated over the pair's
+    contact force (:func:`_pressure_integral`), not decided when it is off 1 by more than the
+    bound);
     ``holds`` is None where the quantity is not defined (p_max with no interior peak on one
     side)."""
     out = []
@@ -513,7 +520,7 @@ def _verdict(c: Mapping) -> str:
     if c["holds"] is None:
         return "not compared (no interior peak on one side)"
     if integral is not None and abs(integral - 1.0) > c["bound"]:
-        return (f"not decided: CalculiX's nodal pressures integrate to {integral:.2f} times the "
+        return (f"not decided: CalculiX's pressures integrate to {integral:.2f} times the "
                 "pair's contact force (its pressure is not resolved)")  # fmt: skip
     if c.get("extrapolation") is not None and mv > c["bound"]:
         return "not decided: CalculiX's uncertainty exceeds the bound"
