@@ -50,6 +50,7 @@ from fegear.io.schema import (
 )
 from fegear.io.topography import FLANKS as TOPOGRAPHY_FLANKS
 from fegear.io.topography import TopographyGrid, read_topography
+from fegear.io.topography_traces import read_flank_traces
 from fegear.options import ContactOptions
 from fegear.units import TORQUE_KEYS, nm_from_nmm, torque2_Nmm_from
 from fegear.units import pinion_torque_Nm as _pinion_torque_Nm
@@ -598,10 +599,17 @@ TOPOGRAPHY = Section(
         Key(k, STRING, f"measured grid of the {k.replace('_', ' ')} flank: a CSV file of normal "
             "deviations in µm (relative to the case file)")
         for k in TOPOGRAPHY_FLANKS
+    ) + tuple(
+        Key(k, STRING, f"measured {t} trace of the {f.replace('_', ' ')} flank (kind "
+            f"'cylindrical'): a CSV file of normal deviations in µm against "
+            f"{'the diameter' if t == 'profile' else 'z from the face centre'} (not with the "
+            "flank's grid)")
+        for f in TOPOGRAPHY_FLANKS for t in ("profile", "lead") for k in (f"{f}_{t}",)
     ),
     "Measured flanks (docs/measured_flanks.md): per member and side a grid of normal deviations "
-    "from the generated flank, interpolated by a spline and added to it in the TCA and the "
-    "loaded analysis. The sector meshes stay those of the design.",
+    "from the generated flank, or (cylindrical) a profile and/or a lead trace, interpolated by "
+    "a spline and added to it in the TCA and the loaded analysis. The sector meshes stay those "
+    "of the design.",
 )  # fmt: skip
 
 
@@ -664,9 +672,10 @@ class GearCase:
         The ``[machine]`` section of a bevel case as written (the flank tables with their
         units), None where the settings are synthesized; :meth:`flank_tables` in mm/deg.
     topography
-        The ``[topography]`` grids by key (``"pinion_drive"``, ...; :mod:`fegear.io.topography`),
-        empty for the design flanks; ``topography_files`` the file names as the case file
-        gives them (relative to its folder).
+        The ``[topography]`` grids by flank key (``"pinion_drive"``, ...;
+        :mod:`fegear.io.topography`; a flank's traces as their grid,
+        :mod:`fegear.io.topography_traces`), empty for the design flanks; ``topography_files``
+        the file names by case-file key as the case file gives them (relative to its folder).
     """
 
     name: str
@@ -1007,6 +1016,8 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
     files = check_table(topo_s, data.get("topography", {}))
     folder = Path(source).parent if source != "<memory>" else Path.cwd()
     grids = {k: read_topography(k, str(files[k]), folder) for k in TOPOGRAPHY_FLANKS if k in files}
+    grids.update(read_flank_traces(files, folder, kind))
+    grids = {k: grids[k] for k in TOPOGRAPHY_FLANKS if k in grids}
 
     given = [k for k in TORQUE_KEYS if k in load]
     if len(given) != 1:
@@ -1063,7 +1074,7 @@ def parse_gear_case(data: dict[str, Any], source: str = "<memory>") -> GearCase:
         source=source,
         machine=copy.deepcopy(machine),
         topography=grids,
-        topography_files={k: str(files[k]) for k in grids},
+        topography_files={k: str(v) for k, v in files.items()},
     )
 
 

@@ -30,6 +30,7 @@ from fegear.geometry.pair_placement import (
     spiral_bevel_assembly,
 )
 from fegear.io.gear_case import PAIR_SECTIONS, GearCase
+from fegear.io.topography_traces import placed
 from fegear.store.cache import cached_file
 from fegear.tca.deviation import MeasuredMember, flank_topography
 
@@ -443,7 +444,7 @@ def measured(case: GearCase, pair: GearPair) -> GearPair:
     members = []
     for name, m in (("pinion", pair.pinion), ("gear", pair.gear)):
         topo = tuple(
-            (g.side, flank_topography(g, m, g.side))
+            (g.side, flank_topography(placed(g, m), m, g.side))
             for g in case.topography.values()
             if g.member == name
         )
