@@ -774,8 +774,8 @@ class GearCase:
             replaces all of them, the ones not given take their defaults), a load, which
             replaces the case's torque (``torque2_Nm``, N·m, or ``torque2_Nmm``, N·mm, on
             member 2; ``pinion_torque_Nm``, N·m, on member 1), ``topography`` (a mapping of
-            the ``[topography]`` keys to grid files: it replaces all of them; ``{}`` the design
-            flanks) and ``source``.
+            the ``[topography]`` keys to grid or trace files: it replaces all of them; ``{}``
+            the design flanks) and ``source``.
 
         Returns
         -------
