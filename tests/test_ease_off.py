@@ -11,12 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import fegear
 from fegear.case_files import load_case
 from fegear.geometry.pair_placement import spiral_bevel_assembly
 from fegear.pipeline.pair import build_pair
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
-from fegear.tca.ease_off import ease_off, ease_off_at
+from fegear.tca.ease_off import EaseOff, ease_off, ease_off_at
+from fegear.tca.ease_off_pair import fit_ease_off
 from fegear.tca.results import ARCSEC
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
@@ -119,3 +121,48 @@ def test_a_lead_crowning_is_a_parabola_across_the_face():
         # a parabola of the crowning's height over the face: 2 % (the first-order ε = θ h and
         # the crowned point's shift along the flank, 2.4 µm, in a grid laid in flank coordinates)
         assert np.abs(d - amp * x**2).max() < 0.02 * amp, (e.u[i], d - amp * x**2)
+
+
+# ------------------------------------------------------------------ the numbers of summary.json
+
+
+def test_the_fit_holds_a_quadratic_exactly():
+    """fit_ease_off on an ease-off that IS a quadratic in the normalised coordinates gives its
+    coefficients back, the undefined corner left out."""
+    u, v = np.linspace(0.2, 1.4, 21), np.linspace(-7.0, 7.0, 41)
+    s = 2 * (u - 0.8) / 1.2
+    t = v / 7.0
+    S, T = np.meshgrid(s, t, indexing="ij")
+    c = (3.0, -1.5, 2.0, 4.0, 7.0, -2.5)
+    eps = c[0] + c[1] * S + c[2] * T + c[3] * S**2 + c[4] * T**2 + c[5] * S * T
+    eps[:4, :6] = np.nan  # below the gear's working flank: no contact position
+    nan = np.full(eps.shape, np.nan)
+    e = EaseOff(u, v, np.zeros(eps.shape + (3,)), nan, nan, nan, eps, 0.0, np.zeros(2))
+    fit = fit_ease_off(e)
+    # a least-squares solve of an exact quadratic: round-off of 6 coefficients of size ~10
+    assert np.allclose(fit[:6], c, rtol=0, atol=1e-12), fit
+    assert fit.rms_um < 1e-12 and fit.nodes == eps.size - 24
+
+
+def test_the_summary_reads_a_lead_crowning_as_lengthwise_crowning():
+    """summary.json's ease_off section of the crowned helical pair: its lengthwise crowning is
+    the lead crowning along the normal, C_β cos β_b, and nothing else is there; the measured
+    pair (the same crowning as a 5 x 9 grid on the uncrowned pair) says the same and that its
+    design pair has none."""
+    beta_b = math.asin(math.sin(math.radians(15.0)) * math.cos(math.radians(20.0)))
+    amp = 10.0 * math.cos(beta_b)  # µm: both cases' 10 µm crowning
+    crowned = fegear.run(load_case(CASES / "helical_crowned.toml"), fidelity="tca")
+    fit = crowned.summary["ease_off"]["fit"]
+    # the first-order ε = θ h of an exact parabola (measured 7e-6 relative)
+    assert abs(fit["lengthwise_crowning_um"] - amp) < 1e-4 * amp, fit
+    # no other term: the pair is conjugate but for the crowning (measured below 1e-7 µm)
+    for k in ("profile_slope_um", "lengthwise_slope_um", "profile_crowning_um", "twist_um"):
+        assert abs(fit[k]) < 1e-5 * amp, (k, fit)
+    measured = fegear.run(load_case(CASES / "helical_measured.toml"), fidelity="tca")
+    eo = measured.summary["ease_off"]
+    # the spline through 5 x 9 grid points of the parabola: 1e-4 relative (measured 6e-5)
+    assert abs(eo["fit"]["lengthwise_crowning_um"] - amp) < 1e-4 * amp, eo["fit"]
+    assert eo["design"]["eps_max_um"] < 1e-6  # the design pair is conjugate
+    # measured minus design: the crowning itself, from 0 at the valley to its height
+    diff = eo["measured_minus_design_um"]
+    assert abs(diff["min"]) < 1e-6 and abs(diff["max"] - eo["eps_max_um"]) < 1e-6, diff

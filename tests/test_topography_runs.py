@@ -96,6 +96,10 @@ def test_a_zero_grid_reproduces_the_design_run(fidelity, zero_grid):
     a, b = _doc(design), _doc(zero)
     # the echo of the grids is the only difference: every number is the same, bit for bit
     assert b["inputs"].pop("topography")["pinion_drive"]["max_um"] == 0.0
+    # and the measured run's ease-off section holds the design's too: the same, no difference
+    design_eo, diff = b["ease_off"].pop("design"), b["ease_off"].pop("measured_minus_design_um")
+    assert design_eo == {k: v for k, v in a["ease_off"].items() if k not in ("file", "grid")}
+    assert diff == {"min": 0.0, "max": 0.0, "rms": 0.0}
     assert differences(a, b) == []
     # the measured run never reads the design's TCA or cycle; it reads its meshes and operators
     used = zero.summary["cache"]

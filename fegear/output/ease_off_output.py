@@ -14,8 +14,8 @@ outputs, every fidelity.
   undefined), ``theta_arcsec``, the minimum's flank coordinates and level; for a measured pair
   (:class:`~fegear.tca.deviation.MeasuredMember`) the design pair's ``design_eps_um`` on the same
   grid and assembly and ``measured_minus_design_um`` (``ε`` of both, each less the design's
-  minimum). ``summary.json`` does not hold them (its keys are compared with the stored
-  references); it lists the files.
+  minimum). ``summary.json`` holds the numbers that describe it (``ease_off``:
+  :mod:`fegear.results.ease_off`).
 """
 
 from __future__ import annotations
@@ -30,21 +30,14 @@ from fegear.output.figure import pyplot as _plt
 from fegear.output.figure import save_png as _save
 from fegear.pipeline.run import GearRun
 from fegear.store.files import atomic_write, write_json
-from fegear.tca import TCA, TCAOptions
-from fegear.tca.deviation import MeasuredMember
-from fegear.tca.ease_off import EaseOff, ease_off
+from fegear.tca.ease_off import EaseOff
+from fegear.tca.ease_off_pair import PairEaseOff, pair_ease_off
 from fegear.tca.plots import axis_label
 from fegear.tca.results import ARCSEC
 
 __all__ = ["RunEaseOff", "run_ease_off", "write_ease_off"]
 
 log = logging.getLogger(__name__)
-
-#: the grid of the run's ease-off: profile × face nodes
-GRID = (21, 41)
-#: the TCA options of the ease-off's TCA object: no search, no separation grid (it only holds
-#: the flank maps, the tooth frames and the gear's start values)
-_OPT = TCAOptions(search_grid=(3, 3), separation_grid=None, edge_samples=3)
 
 
 @dataclass(frozen=True)
@@ -68,22 +61,16 @@ class RunEaseOff:
     @property
     def difference_um(self) -> np.ndarray | None:
         """``(nu, nv)`` µm, measured minus design (each ``θ_e h`` less the design's minimum)."""
-        if self.design is None:
-            return None
-        e, d = self.ease_off, self.design
-        return (e.eps_um * 1e-3 + e.eps_min_mm - d.eps_min_mm) * 1e3 - d.eps_um
+        return PairEaseOff(self.ease_off, self.design).difference_um
 
 
 def run_ease_off(run: GearRun) -> RunEaseOff:
-    """The :class:`RunEaseOff` of ``run`` (its pair in the assembly the analysis phased)."""
+    """The :class:`RunEaseOff` of ``run`` (its pair in the assembly the analysis phased: the
+    run's own, else made, :func:`fegear.tca.ease_off_pair.pair_ease_off`)."""
     p = run.pair
-    e = ease_off(TCA(p.pinion, p.gear, run.assembly, _OPT), GRID)
-    design = None
-    if isinstance(p.pinion, MeasuredMember) or isinstance(p.gear, MeasuredMember):
-        base = [m.base if isinstance(m, MeasuredMember) else m for m in (p.pinion, p.gear)]
-        design = ease_off(TCA(base[0], base[1], run.assembly, _OPT), GRID)
+    pe = run.ease_off or pair_ease_off(p.pinion, p.gear, run.assembly)
     uv = np.array([x.pinion_uv for x in run.ellipses if x is not None]).reshape(-1, 2)
-    return RunEaseOff(e, design, uv)
+    return RunEaseOff(pe.ease_off, pe.design, uv)
 
 
 def _json_grid(a: np.ndarray, scale: float = 1.0, digits: int = 4) -> list:

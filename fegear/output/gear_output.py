@@ -75,7 +75,7 @@ Files written to the output folder (each one atomically: complete or absent):
   (unloaded, paint thickness).
 - ``ease_off.png``, ``ease_off.vts``, ``ease_off.json`` (every fidelity) — the ease-off of the
   pair over the pinion flank (:mod:`fegear.output.ease_off_output`, ``docs/ease_off.md``): its
-  numbers are in ``ease_off.json``, not in ``summary.json``.
+  grid is in ``ease_off.json``, the numbers that describe it in ``summary.json``'s ``ease_off``.
 """
 
 from __future__ import annotations

@@ -48,6 +48,7 @@ from fegear.store.records import cached_object
 from fegear.tca import TCAOptions
 from fegear.tca.cached import cached_tca
 from fegear.tca.cycle import cycle_result
+from fegear.tca.ease_off_pair import PairEaseOff, pair_ease_off
 from fegear.tca.ellipse import EllipseAt, ellipses
 from fegear.tca.results import ARCSEC, CycleResult
 
@@ -93,6 +94,9 @@ class GearRun:
     cycle_key
         The cache key of the loaded cycle (:mod:`fegear.ltca.cached`; "" for none): what its
         displacement fields are cached under.
+    ease_off
+        The ease-off of the pair in :attr:`assembly` (and of its design pair for measured
+        flanks; :mod:`fegear.tca.ease_off_pair`), or None.
     """
 
     case: GearCase
@@ -106,6 +110,7 @@ class GearRun:
     cache: CacheUse | None = None
     ellipses: tuple[EllipseAt | None, ...] = ()
     cycle_key: str = ""
+    ease_off: PairEaseOff | None = None
 
     @property
     def fidelity(self) -> str:
@@ -302,6 +307,15 @@ def check_case(case: GearCase, workers: int | None = 1) -> Engagement | None:
     return _loaded_checks(case, pair, clearance, _ltca_options(case, workers))[2]
 
 
+def _ease_off(pair: GearPair, asm: Assembly, seconds: dict[str, float]) -> PairEaseOff:
+    """The ease-off of ``pair`` in ``asm`` (:func:`fegear.tca.ease_off_pair.pair_ease_off`,
+    from the cache when made before), its wall time put in ``seconds``."""
+    t0 = time.perf_counter()
+    e = pair_ease_off(pair.pinion, pair.gear, asm)
+    seconds["ease_off"] = time.perf_counter() - t0
+    return e
+
+
 def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, fields, reuse):
     case = _override(case, fidelity, level)
     say = progress or (lambda stage, i, n: None)
@@ -328,7 +342,7 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, field
         seconds["tca"] = time.perf_counter() - t0
         return GearRun(
             case=case, pair=pair, assembly=tca.asm, tca=r, seconds=seconds, engagement=eng,
-            ellipses=ell,
+            ellipses=ell, ease_off=_ease_off(pair, tca.asm, seconds),
         )  # fmt: skip
 
     opt = _ltca_options(case, workers)
@@ -364,8 +378,9 @@ def _run_gear_case(case, fidelity, level, progress, pair, workers, notify, field
         seconds["cycle_read"] = cycle.seconds["read"]
         say("cached", None, None)
     asm = pair.assembly.with_phase2(cycle.phase2)  # the phase run_ltca closed the pair with
+    eo = _ease_off(pair, asm, seconds)
     run = GearRun(case=case, pair=pair, assembly=asm, cycle=cycle, seconds=seconds, engagement=eng,
-                  ellipses=ell, cycle_key=key if reuse else "")  # fmt: skip
+                  ellipses=ell, cycle_key=key if reuse else "", ease_off=eo)  # fmt: skip
     if fields or case.root_stress:  # else the numbers only: the fields when written
         return with_fields(run, say)
     return run

@@ -20,6 +20,7 @@ from fegear.ltca.position import CAPPED
 from fegear.ltca.validity import ValidityCheck, validity_checks
 from fegear.pipeline.run import GearRun
 from fegear.results.cylindrical import cylindrical_section, te_harmonics
+from fegear.results.ease_off import ease_off_section
 from fegear.results.model import (
     TCA_LOST,
     Checks,
@@ -546,6 +547,7 @@ def build_result(run: GearRun, pattern: Mapping[str, PatternCentre] | None = Non
         mesh=mesh,
         validity=_plain(validity),
         cylindrical=_plain(cylindrical_section(run)),
+        ease_off=ease_off_section(run),
         cache=_plain(run.cache.as_dict()) if run.cache is not None else None,
         versions=versions(),
     )

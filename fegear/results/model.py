@@ -402,6 +402,9 @@ class GearRunResult:
         The checks of the model's validity range (loaded fidelities), or None.
     cylindrical
         The cylindrical pair's section (contact ratios, load distribution), or None.
+    ease_off
+        The numbers that describe the pair's ease-off (:mod:`fegear.results.ease_off`), or
+        None.
     cache
         The artefact-cache lookups of the run (folder, artefacts read and built), or None.
     versions
@@ -422,6 +425,7 @@ class GearRunResult:
     mesh: Json | None = None
     validity: Json | None = None
     cylindrical: Json | None = None
+    ease_off: Json | None = None
     cache: Json | None = None
     versions: Mapping[str, str] = field(default_factory=dict)
 

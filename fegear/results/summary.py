@@ -253,6 +253,8 @@ def summary_document(r: GearRunResult, files: list[str] | None = None) -> dict[s
         doc["validity"] = r.validity
     if r.cylindrical is not None:
         doc["cylindrical"] = r.cylindrical
+    if r.ease_off is not None:
+        doc["ease_off"] = r.ease_off
     doc["pattern"] = (
         {m: pc.as_dict() for m, pc in r.pattern.items()} if r.pattern is not None else None
     )
@@ -488,6 +490,7 @@ def result_from_summary(doc: Mapping[str, Any]) -> GearRunResult:
         mesh=doc.get("mesh"),
         validity=doc.get("validity"),
         cylindrical=doc.get("cylindrical"),
+        ease_off=doc.get("ease_off"),
         cache=doc.get("cache"),
         versions=doc["versions"],
     )

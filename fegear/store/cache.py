@@ -326,6 +326,8 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "phase": _TCA,
         "contact_path": _TCA,
         "handover": _TCA,
+        # the ease-off of a run's pair on its grid (fegear.tca.ease_off_pair)
+        "ease_off": _TCA,
         # a loaded cycle, every position solved (fegear.ltca.cached), and the displacement
         # fields of a run of it (fegear.pipeline.fields): everything they are computed with
         "cycle": Producer(_CYCLE_CODE, (*_FE_DEPS, "threadpoolctl")),

@@ -102,6 +102,13 @@ HARMONIC_ATOL_ARCSEC = 1e-3
 ELLIPSE_RTOL = 3e-3
 ELLIPSE_ATOL = ELLIPSE_RTOL * B_MAX
 
+#: the ease-off (fegear/tca/ease_off.py): a gap θ_e solved to ANGLE_RAD times an arm of at most
+#: 500 mm (the face gear) is 5e-9 mm; its fit is linear in the gaps. 20 x that, in µm and mm
+EASE_OFF_ATOL_UM = 1e-4
+#: a node of the ease-off's grid on the border of the gear's working flank may gain or lose its
+#: contact position with round-off: one node of the 21 x 41 grid
+EASE_OFF_NODE = 1.0 / (21 * 41)
+
 #: ``(path pattern, rtol, atol, reason)``: the first pattern matching a leaf's path decides
 TOLERANCES: list[tuple[re.Pattern[str], float, float, str]] = [
     (re.compile(p), rtol, atol, why)
@@ -138,6 +145,14 @@ TOLERANCES: list[tuple[re.Pattern[str], float, float, str]] = [
          "a patch's axes, to LOADED_RTOL; a patch of one cell measures 0 to round-off"),
         (r"^\.validity\.checks\[\d+\]\.value$", LOADED_RTOL, ATOL,
          "the validity checks read the loaded cycle's approach and p_max"),
+        (r"^\.ease_off\.(design\.)?defined_fraction$", 0.0, EASE_OFF_NODE,
+         "a node on the border of the gear's working flank: EASE_OFF_NODE"),
+        (r"^\.ease_off\.(design\.)?fit\.nodes$", 0.0, 1.0,
+         "the fit's nodes: one on the border of the gear's working flank"),
+        (r"^\.ease_off\..*_mm$", 0.0, 1e-3 * EASE_OFF_ATOL_UM,
+         "the ease-off's level: a gap to EASE_OFF_ATOL_UM (in mm)"),
+        (r"^\.ease_off\.", 0.0, EASE_OFF_ATOL_UM,
+         "gaps solved to EASE_OFF_ATOL_UM and their linear fit"),
         (r"^\.(positions\[\d+\]\.pairs\[\d+\]\.contact_point_mm|cycle\.path_|pattern\.)",
          0.0, LOCATION_MM,
          "the TCA's contact points, located to LOCATION_MM, and what is measured from them (the "
