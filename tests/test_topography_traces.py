@@ -181,6 +181,47 @@ def test_a_profile_trace_gives_the_tca_of_the_same_grid(tmp_path):
     assert a["inputs"]["topography"]["pinion_drive"]["max_um"] == pytest.approx(dev.max())
 
 
+def test_a_profile_trace_in_roll_length_gives_the_profile_crowned_tca(tmp_path):
+    """An 8 µm profile crowning (a parabola in the roll length L) read at 11 points at mid-face,
+    given against L (``roll_mm``) and against the diameter: each gives the crowned pair's TCA
+    to its own interpolation error, which is rounding in L and 1.8e-4 mm in d (L ∝ √(d − d_b)
+    is steep at the form circle). The spur pair (β = 0): the crowned helical pair touches at the
+    face ends, where the analytic crowning (along the transverse line of action) and the trace
+    (along the normal) put the flank's edge δ_t sin β_b ≈ 2 µm apart (TE 5e-5″ apart)."""
+    design = _design(_crowned())
+    design = design.replace(pair={**design.pair, "helix_angle_deg": 0.0})
+    crowned = design.replace(pair={**design.pair, "profile_crowning_mm": [0.008, 0.0]})
+    flat, mod = build_pair(design).pinion, build_pair(crowned).pinion
+    nominal, modified = flank_map(flat, "drive"), flank_map(mod, "drive")
+    bd = nominal.bounds
+    u = np.linspace(bd.u_fillet, bd.u_tip, 11)
+    L = flat.roll_length(u)
+    dev = 1e3 * normal_deviation(nominal, modified, u, 0 * u)
+    _write_trace(tmp_path / "roll.csv", "roll_mm, removed_um", L, dev)
+    _write_trace(tmp_path / "dia.csv", "diameter_mm, removed_um", 2 * np.hypot(flat.r_b, L), dev)
+    U, V = np.meshgrid(np.linspace(bd.u_fillet, bd.u_tip, 81),
+                       np.linspace(bd.v_start, bd.v_end, 5), indexing="ij")  # fmt: skip
+    exact = normal_deviation(nominal, modified, U, V)
+    a = _tca(crowned)
+    te = [p["te_unloaded_arcsec"] for p in a["positions"]]
+    assert max(te) - min(te) > 4.0  # the crowning shows in the TE (measured 9.5″ p-p)
+    rb2, beta_b = build_pair(design).gear.r_b, flat.beta_b
+    errs = {}
+    for name in ("roll", "dia"):
+        case = design.replace(topography={"pinion_drive_profile": str(tmp_path / f"{name}.csv")})
+        topo = build_pair(case).pinion.topography("drive")
+        errs[name] = err = float(np.abs(topo.deviation(U, V)[0] - exact).max())
+        # a gap error e turns the gear by at most e / (r_b2 cos β_b); 1e-9″ the TCA's closing
+        # (measured: roll 9e-11″ of 1.03e-9″, diameter 0.016″ of 0.73″)
+        te_tol = ARCSEC * err / (rb2 * math.cos(beta_b)) + 1e-9
+        b = _tca(case)
+        for pa, pb in zip(a["positions"], b["positions"], strict=True):
+            assert abs(pa["te_unloaded_arcsec"] - pb["te_unloaded_arcsec"]) < te_tol, name
+    assert b["inputs"]["topography"]["pinion_drive"]["coordinates"] == "diameter_mm"
+    # the parabola in L, reproduced by the cubic: rounding (measured 7e-15 mm); in d 1.8e-4 mm
+    assert errs["roll"] < 1e-12 and 1e-5 < errs["dia"] < 3e-4
+
+
 # ------------------------------------------------------------------ a zero trace
 
 
@@ -237,6 +278,23 @@ def test_one_trace_is_one_row_or_one_column_and_added_is_negated():
     assert g.member == "gear" and g.side == "coast"
     g = trace_grid("gear_coast", None, _trace("z_mm, removed_um\n-5, 2\n5, 2\n"))
     assert g.deviation_um.shape == (1, 2) and np.isnan(g.profile).all()  # placed on the member
+
+
+def test_roll_lengths_for_profile_traces_and_grids(tmp_path):
+    p = _trace("roll_mm, removed_um\n5, 1\n15, 3\n", "pinion_drive_profile", "p.csv")
+    ld = _trace("at_roll_mm, 10\nz_mm, removed_um\n-7, 2\n7, 2\n")
+    g = trace_grid("pinion_drive", p, ld)
+    assert g.coordinates == "roll_mm" and g.crossing == (10.0, 0.0) and g.mismatch_um == 0.0
+    # a lead trace's position in the other coordinate than the profile trace's: refused
+    with pytest.raises(InputError, match=r"t.csv: row 1, column 1\).*'at_roll_mm'"):
+        trace_grid("pinion_drive", p, _trace(GOOD))
+    # a lead trace alone at a roll length; placed on the member in roll length without one
+    assert trace_grid("pinion_drive", None, ld).coordinates == "roll_mm"
+    # a grid in roll lengths: the rows off the working flank (as roll lengths) are refused
+    (tmp_path / "g.csv").write_text("roll_mm, -7, 7\n3, 0, 0\n30, 0, 0\n", encoding="utf-8")
+    case = _design(_crowned()).replace(topography={"pinion_drive": str(tmp_path / "g.csv")})
+    with pytest.raises(InputError, match=r"g.csv: row 3, column 1\).*as a roll length"):
+        build_pair(case)
 
 
 def test_a_lead_trace_alone_sits_on_the_mid_working_depth(tmp_path):

@@ -14,7 +14,9 @@ starting with ``#`` are comments)::
 - the **corner cell** names the coordinates: ``normalized`` (profile 0 at the start of the
   working flank → 1 at the tip; face 0 at its start — toe, inner radius, ``−b/2`` — → 1 at its
   end) for every family, or ``diameter_mm`` (cylindrical members only: the rows are diameters in
-  mm, the columns axial positions ``z`` in mm from the face centre of the member);
+  mm, the columns axial positions ``z`` in mm from the face centre of the member), or
+  ``roll_mm`` (cylindrical: the rows are roll lengths ``L = √(r² − r_b²)`` in mm, the abscissa
+  of a profile chart; the columns as ``diameter_mm``);
 - the rest of the **first row** are the face coordinates, the rest of the **first column** the
   profile coordinates, both strictly increasing, at least 2 of each;
 - the **body** are the deviations in µm, finite, one per face coordinate on every row.
@@ -49,7 +51,7 @@ __all__ = [
 #: The ``[topography]`` keys: member and flank side.
 FLANKS = ("pinion_drive", "pinion_coast", "gear_drive", "gear_coast")
 #: The corner cell of a grid file: its coordinates.
-COORDINATES = ("normalized", "diameter_mm")
+COORDINATES = ("normalized", "diameter_mm", "roll_mm")
 
 
 @dataclass(frozen=True)
@@ -63,9 +65,10 @@ class TopographyGrid:
     path
         The file (as resolved from the case file's folder).
     coordinates
-        ``"normalized"`` or ``"diameter_mm"`` (the corner cell).
+        ``"normalized"``, ``"diameter_mm"`` or ``"roll_mm"`` (the corner cell).
     profile
-        ``(n_p,)`` profile coordinates (fraction of the working profile, or diameters in mm).
+        ``(n_p,)`` profile coordinates (fraction of the working profile, or diameters or roll
+        lengths in mm).
     face
         ``(n_f,)`` face coordinates (fraction of the face, or axial positions in mm).
     deviation_um
