@@ -354,3 +354,41 @@ def test_contact_points_reader_recovers_each_points_area(tmp_path):
     assert f.sum() == pytest.approx(60.0) and np.all(f > 0.0)  # by area without a nodal field
     (tmp_path / "none.dat").write_text("")
     assert read_dat_points(tmp_path / "none.dat") is None
+
+
+def test_patch_boxes_hold_the_tca_contact_line_narrowly():
+    """FZG at the pitch point: the patch strips of a locally refined deck
+    (:func:`fegear.export.gear_deck.patch_boxes`) hold the pinion cells of the TCA's smallest
+    separation of each face-width column, end where the separation reaches the gap, and are
+    narrower than the reach's boxes; the gear gets one box per pinion strip."""
+    from fegear.export.gear_deck import DEFAULT_REACH_MM, patch_boxes
+    from fegear.ltca import LTCAOptions
+    from fegear.ltca.analysis import cycle_zone
+    from fegear.ltca.cycle import cycle_tca
+    from fegear.ltca.zone import contact_zone
+    from fegear.pipeline.pair import build_pair
+    from fegear.validation.rows import pitch_point_phi1
+
+    case = load_case(CASES / "fzg_spur.toml")
+    pair = build_pair(case)
+    opt = LTCAOptions(n_positions=case.n_positions, level=case.level, n_teeth=case.n_teeth,
+                      E_MPa=case.E_MPa, nu=case.nu, fidelity="fe",
+                      **case.contact.as_dict())  # fmt: skip
+    phi1 = pitch_point_phi1(pair)
+    tca, (pos,), _ = cycle_tca(pair.pinion, pair.gear, pair.assembly, opt, np.array([phi1]))
+    n = cycle_zone(pair.pinion, pair.gear, pair.assembly, opt).n_teeth
+    asm, b1, b2 = tca.asm, tca.fm1.bounds, tca.fm2.bounds
+    reach = contact_zone([pos], b1, b2, asm.side1, asm.side2, DEFAULT_REACH_MM, n_teeth=n)
+    gap = 0.01
+    z1, z2 = patch_boxes(pos, reach.pairs, b1, b2, asm.side1, asm.side2, n // 2, gap, 0.0)
+    (g,) = [g for g in pos.grids if (g.k, g.j) == (0, 0)]
+    assert len(z1) == len(z2) == len(g.v)  # a strip per face-width column
+    width = max(z.u[1] - z.u[0] for z in reach.pinion) * len(reach.pinion)
+    for z in z1:
+        col = int(np.argmin(np.abs(g.v - 0.5 * (z.v[0] + z.v[1]))))
+        ok = g.valid[:, col]
+        s = np.interp(z.u, g.u[ok], g.separation[ok, col])
+        assert z.u[0] <= g.u[ok][np.argmin(g.separation[ok, col])] <= z.u[1]
+        # the parabola through three samples 0.34 mm apart: its ends within 1 µm of the gap
+        np.testing.assert_allclose(s, gap, atol=1e-3)
+        assert 0.3 < z.u[1] - z.u[0] < 0.5 * width  # ±0.36 mm; the reach's boxes ±1.0 mm

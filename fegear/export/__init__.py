@@ -65,6 +65,8 @@ def export_ccx(
     phi1: Sequence[float] = (),
     reach_mm: float | None = None,
     level: int | None = None,
+    patch_mm: float | None = None,
+    patch_gap_mm: float | None = None,
 ) -> list[Path]:
     """Write the CalculiX decks of ``case`` into ``out``: ``<job>.inp`` and its record
     ``<job>.json`` each. Returns the ``.inp`` paths.
@@ -87,6 +89,11 @@ def export_ccx(
         scene: the level whose element size the contact gets when ``element_mm`` is not given
         (default :data:`DEFAULT_HERTZ_LEVEL`, not the case's level: level 3, the case's, takes
         CalculiX 12 minutes).
+    patch_mm, patch_gap_mm
+        Gear pairs: elements of ``patch_mm`` along each pair's contact patch (the strip where
+        the TCA separation is below ``patch_gap_mm``, default
+        :data:`~fegear.export.gear_deck.DEFAULT_PATCH_GAP_MM`), coarse elsewhere
+        (:func:`fegear.export.gear_deck.gear_deck`).
     """
     # local: the scene and the decks pull scipy, scikit-fem and meshio; the `fegear` command's
     # parser imports this package
@@ -103,6 +110,8 @@ def export_ccx(
 
         if phi1:
             raise InputError("positions", list(phi1), "none for the Hertz scene")
+        if patch_mm is not None:
+            raise InputError("patch_mm", patch_mm, "none for the Hertz scene (--element-mm)")
         if element_mm is None:
             lv = DEFAULT_HERTZ_LEVEL if level is None else level
             if not (isinstance(lv, int) and 0 <= lv < len(CELLS_ACROSS_MINOR)):
@@ -113,10 +122,19 @@ def export_ccx(
             element_mm = ELEMENT_TO_CELL * 2 * b / CELLS_ACROSS_MINOR[lv]
         return [hertz_deck(case.scene, element_mm, name=f"{case.name}_{element_mm:.3g}mm")
                 .write(out)]  # fmt: skip
-    from fegear.export.gear_deck import DEFAULT_REACH_MM, gear_deck  # local: as above
+    from fegear.export.gear_deck import (  # local: as above
+        DEFAULT_PATCH_GAP_MM,
+        DEFAULT_REACH_MM,
+        gear_deck,
+    )
 
     if not phi1:
         raise InputError("positions", [], "at least one position of a gear pair")
     h = DEFAULT_GEAR_ELEMENT_MM if element_mm is None else element_mm
     reach = DEFAULT_REACH_MM if reach_mm is None else reach_mm
-    return [gear_deck(case, p, h, reach_mm=reach, level=level).write(out) for p in phi1]
+    gap = DEFAULT_PATCH_GAP_MM if patch_gap_mm is None else patch_gap_mm
+    return [
+        gear_deck(case, p, h, reach_mm=reach, level=level, patch_mm=patch_mm,
+                  patch_gap_mm=gap).write(out)
+        for p in phi1
+    ]  # fmt: skip

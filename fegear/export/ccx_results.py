@@ -606,7 +606,7 @@ def read_results(job: str | Path) -> CcxResult:
         nodal = float(face_integral(loc, X, p_nodes).sum())
         mirror = hertz and rec["modelled_fraction"] < 1.0
         border = rec.get("edge_nodes", {}).get(p["slave"], [])
-        h = float(rec["element_mm"])
+        h = float(rec.get("patch_mm") or rec["element_mm"])  # the elements along the patch
         sides = rec.get("slave_sides", {}).get(p["slave"])
         pmax_nodal = float(max((press.get(int(n), 0.0) for n in nodes), default=0.0))
         if points is not None and sides is not None:

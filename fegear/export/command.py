@@ -39,6 +39,12 @@ def add_parser(sub) -> None:
     e.add_argument("--level", type=int, help="gear pairs: sector mesh level away from the "
                    "contact (default: the case's); the Hertz scene: the level whose element size "
                    "the contact gets (default 1: 0.24 mm, ~2.5 min of ccx on 2 cores)")  # fmt: skip
+    e.add_argument("--patch-mm", type=float, help="gear pairs: element size in mm along each "
+                   "pair's contact patch (the flank strip where the TCA separation is below "
+                   "--patch-gap-mm), coarse elsewhere (default: none, the reach's boxes at "
+                   "--element-mm)")  # fmt: skip
+    e.add_argument("--patch-gap-mm", type=float, help="gear pairs: the separation that bounds "
+                   "the patch strips of --patch-mm (default 0.01)")  # fmt: skip
     e.add_argument("--out", default="ccx", help="output folder (default: ./ccx)")
     e.add_argument("--run", action="store_true", help="run ccx on each deck and read it back")
     e.add_argument("--threads", type=int, default=1, help="OMP_NUM_THREADS of ccx (default 1)")
@@ -72,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--positions", None, "positions of the gear pair (or --phi1-deg)")
     if args.run:
         find_ccx()  # a missing ccx is said before any meshing
-    paths = export_ccx(case, args.out, args.element_mm, phi1, args.reach_mm, args.level)
+    paths = export_ccx(case, args.out, args.element_mm, phi1, args.reach_mm, args.level,
+                       args.patch_mm, args.patch_gap_mm)  # fmt: skip
     for p in paths:
         rec = json.loads(p.with_suffix(".json").read_text(encoding="utf-8"))
         say(f"wrote {p} ({rec['n_nodes']} nodes, {rec['n_elements']} C3D10, "
