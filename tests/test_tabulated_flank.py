@@ -81,3 +81,32 @@ def test_the_tca_map_of_a_bevel_member_is_the_table(spiral_bevel_pair):
 
     fm = flank_map(spiral_bevel_pair.gear, "drive")
     assert fm._nf() is spiral_bevel_pair.gear.tabulated_flank("drive")
+
+
+def test_a_table_read_back_from_the_cache_is_the_table_built(spiral_bevel_pair):
+    """fegear/tca/flank_tables.py: a member that reads its table from the artefact cache (a new
+    process's member: same settings, no table yet) evaluates bit for bit as the member that
+    built it, its inversion and its exact evaluator included; the second read is a cache hit."""
+    import dataclasses
+
+    from fegear.store.cache import record_cache_use
+    from fegear.tca.flank_tables import flank_table
+
+    built = spiral_bevel_pair.pinion
+    fresh = dataclasses.replace(built, _cache={})  # the same member as another process has it
+    assert repr(fresh) == repr(built)
+    with record_cache_use() as used:
+        a = flank_table(built, "drive")  # built (or read: another test may have stored it)
+        b = flank_table(fresh, "drive")
+    assert used().hits.get("flank_table", 0) >= 1
+    assert b is not a and isinstance(b, TabulatedFlank)
+    s, th = _sample(a, 500, 1.0, seed=3)  # inside and outside the table
+    for x, y in zip(a.evaluate(s, th, True), b.evaluate(s, th, True), strict=True):
+        assert np.array_equal(x, y)
+    bd = built.boundaries()
+    u, v = np.meshgrid(np.linspace(0.1, 0.9, 5), np.linspace(bd.v_start, bd.v_end, 5))
+    for x, y in zip(a.native(u, v), b.native(u, v), strict=True):
+        assert np.array_equal(x, y)
+    na, nb = built.native_flank("drive"), fresh.native_flank("drive")
+    for x, y in zip(na.evaluate(s, th), nb.evaluate(s, th), strict=True):
+        assert np.array_equal(x, y)

@@ -334,6 +334,8 @@ PRODUCERS: Mapping[str, Producer] = MappingProxyType(
         "member_fields": Producer(
             (*_CYCLE_CODE, "fegear.pipeline.fields"), (*_FE_DEPS, "threadpoolctl")
         ),
+        # a bevel or hypoid flank's table (fegear.tca.flank_tables)
+        "flank_table": Producer(("fegear.geometry",), ("numpy", "scipy")),
         # the synthesized spiral bevel pair (fegear.pipeline.pair)
         "bevel_pair": Producer(("fegear.geometry",), ("numpy", "scipy")),
         # the face gear's undercut/pointing limits and fillet-limit tables (fegear.pipeline.pair)

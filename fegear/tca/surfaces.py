@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..geometry.surface import FlankBoundaries, GeneratedMember
+from .flank_tables import flank_table
 
 __all__ = [
     "FlankMap",
@@ -356,7 +357,7 @@ class SpiralBevelMap(FlankMap):
     def _nf(self):
         nf = self._cache.get("nf")
         if nf is None:
-            nf = self._cache["nf"] = self.member.tabulated_flank(self.side)
+            nf = self._cache["nf"] = flank_table(self.member, self.side)
         return nf
 
     def evaluate(self, a, b):

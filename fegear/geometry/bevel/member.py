@@ -56,7 +56,7 @@ from .blank import BevelBlank
 from .cutter import EdgeRadius, blade_tip
 from .machine import MachineSettings, blank_placement, head_cutter, machine_motion, point_plane
 from .native import NativeFillet, NativeFlank, cone_coords
-from .tabulated import tabulate
+from .tabulated import FlankTableRecord, TabulatedFlank, flank_record, from_record, tabulate
 
 __all__ = ["FlankEvaluation", "FilletLimit", "SpiralBevelMember"]
 
@@ -550,6 +550,25 @@ class SpiralBevelMember:
         if tf is None:
             tf = self._cache[key] = tabulate(self.native_flank(side))
         return tf
+
+    def tabulated_record(self, side: Side) -> FlankTableRecord | None:
+        """:meth:`tabulated_flank` as plain arrays (:func:`~.tabulated.flank_record`), or None
+        where no table met the tolerance (the exact evaluator is used)."""
+        tf = self.tabulated_flank(side)
+        if not isinstance(tf, TabulatedFlank):
+            return None
+        return flank_record(tf, self.native_flank(side))
+
+    def adopt_tabulated(self, side: Side, record: FlankTableRecord) -> NativeFlank:
+        """:meth:`tabulated_flank` from ``record`` (:meth:`tabulated_record` of the same member,
+        e.g. read back from a cache) instead of building it; the exact evaluator with it. A
+        member that has built its own keeps it."""
+        key = ("tabulated", side)
+        if key not in self._cache:
+            tab, native = from_record(self, side, record)
+            self._cache.setdefault(("native", side), native)
+            self._cache[key] = tab
+        return self._cache[key]
 
     def native_fillet(self, side: Side) -> NativeFillet:
         """Fast exact evaluator of the ``side`` fillet in the edge-radius parameters ``(ϑ, θ)``

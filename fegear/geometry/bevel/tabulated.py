@@ -28,9 +28,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import SolverError
-from .native import NativeFlank
+from .native import NativeFlank, _compile
 
-__all__ = ["TabulatedFlank", "TABLE_TOL_MM", "tabulate"]
+__all__ = ["FlankTableRecord", "TabulatedFlank", "TABLE_TOL_MM", "flank_record", "from_record",
+           "tabulate"]  # fmt: skip
 
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
@@ -260,3 +261,86 @@ def tabulate(nf: NativeFlank) -> NativeFlank:
     log.info("%s %s flank not tabulated (error %.1e mm > %.0e mm): exact evaluation",
              nf.member.name, nf.side, err, TABLE_TOL_MM)  # fmt: skip
     return nf
+
+
+# ------------------------------------------------------------------ a table as plain data
+
+
+@dataclass(frozen=True)
+class FlankTableRecord:
+    """What a :class:`TabulatedFlank` is made of beyond its member, as plain arrays (for a cache
+    on disk: :func:`flank_record`, :func:`from_record`). A spline is its knots, coefficients and
+    degrees ``(tx, ty, c, kx, ky)`` (:class:`scipy.interpolate.RectBivariateSpline`'s ``tck``).
+
+    Attributes
+    ----------
+    psi, inverse9, inverse
+        The ψ table of the exact evaluator (:meth:`NativeFlank.build`), the exact evaluator's
+        9 × 9 inverse predictor (``(s, θ)`` splines) and the table's finer one.
+    box
+        ``(lo, hi)`` the working box in ``(s, θ)``.
+    coef, axes, table_box, error_mm, normal_error, far_error_mm
+        As :class:`TabulatedFlank`.
+    """
+
+    psi: tuple
+    inverse9: tuple[tuple, tuple]
+    inverse: tuple[tuple, tuple]
+    box: tuple[Array, Array]
+    coef: Array
+    axes: tuple[tuple[float, float], tuple[float, float]]
+    table_box: tuple[Array, Array]
+    error_mm: float
+    normal_error: float
+    far_error_mm: float
+
+
+def _tck(spline) -> tuple:
+    tx, ty, c = spline.tck
+    kx, ky = spline.degrees
+    return (np.asarray(tx), np.asarray(ty), np.asarray(c), int(kx), int(ky))
+
+
+def _spline(tck: tuple):
+    """The :class:`~scipy.interpolate.RectBivariateSpline` of ``tck = (tx, ty, c, kx, ky)``:
+    the same object the fit made (its evaluation reads ``tck`` and ``degrees`` only)."""
+    from scipy.interpolate import RectBivariateSpline
+
+    tx, ty, c, kx, ky = tck
+    spline = RectBivariateSpline.__new__(RectBivariateSpline)
+    spline.tck = (np.asarray(tx), np.asarray(ty), np.asarray(c))
+    spline.degrees = (int(kx), int(ky))
+    return spline
+
+
+def flank_record(tab: TabulatedFlank, native: NativeFlank) -> FlankTableRecord:
+    """``tab`` (and ``native``, the exact evaluator it was made from) as a
+    :class:`FlankTableRecord`."""
+    return FlankTableRecord(
+        psi=_tck(tab.spline),
+        inverse9=(_tck(native.inverse[0]), _tck(native.inverse[1])),
+        inverse=(_tck(tab.inverse[0]), _tck(tab.inverse[1])),
+        box=tab.box,
+        coef=tab.coef,
+        axes=tab.axes,
+        table_box=tab.table_box,
+        error_mm=tab.error_mm,
+        normal_error=tab.normal_error,
+        far_error_mm=tab.far_error_mm,
+    )
+
+
+def from_record(member, side, rec: FlankTableRecord) -> tuple[TabulatedFlank, NativeFlank]:
+    """The table and its exact evaluator of ``member``'s ``side`` flank from ``rec``
+    (:func:`flank_record` of the same member and side): equal to the ones built, bit for bit
+    (the tool and motion are the member's own, the arrays the ones stored)."""
+    tool, mot = member._tools(side)
+    steps = _compile(mot.factors)
+    psi = _spline(rec.psi)
+    native = NativeFlank(member, side, tool, steps, psi, tuple(map(_spline, rec.inverse9)),
+                         rec.box)  # fmt: skip
+    tab = TabulatedFlank(
+        member, side, tool, steps, psi, tuple(map(_spline, rec.inverse)), rec.box, rec.coef,
+        rec.axes, rec.table_box, rec.error_mm, rec.normal_error, rec.far_error_mm,
+    )  # fmt: skip
+    return tab, native
