@@ -258,6 +258,9 @@ def test_the_surface_is_separable_through_the_crossing():
     # rows: the profile trace's diameters, columns: the lead trace's z; δ_c = 3 at (75, 2)
     assert g.profile.tolist() == [70, 75, 80, 85] and g.face.tolist() == [-7, 0, 2, 7]
     assert g.deviation_um[:, 2].tolist() == [1, 3, 2, 5]  # the profile trace at z_P
+    # both files are named where the flank's source is reported (acceptance.json, echo)
+    assert g.files == (Path("p.csv"), Path("t.csv"))
+    assert g.echo()["file"] == "p.csv + t.csv"
     assert g.deviation_um[1].tolist() == [4, 1, 3, 6]  # the lead trace at d_L
     assert g.rows == (3, 4, 5, 6) and g.cols == (4, 5, 6, 7)  # the files' lines
     # disagreeing traces: averaged at the crossing (each shifted by half), with a warning

@@ -196,7 +196,7 @@ class Verdict:
 
         def run(r: GearResult) -> dict[str, Any]:
             return {"case": r.case.name, "source": str(r.case.source),
-                    "topography": {k: {"file": str(g.path), "sha256": g.sha256}
+                    "topography": {k: {"file": " + ".join(map(str, g.files)), "sha256": g.sha256}
                                    for k, g in r.case.topography.items()}, "fidelity": r.fidelity,
                     "level": r.level, "n_positions": r.cycle.n_positions}  # fmt: skip
 

@@ -114,6 +114,11 @@ class TopographyGrid:
         place = ", ".join(a for a in at if a)
         return f"topography.{self.key} ({self.path.name}" + (f": {place})" if place else ")")
 
+    @property
+    def files(self) -> tuple[Path, ...]:
+        """The files the flank's deviation was read from (one grid file)."""
+        return (self.path,)
+
     def echo(self) -> dict[str, object]:
         """What ``summary.json`` says of the grid (``inputs.topography.<key>``)."""
         return {

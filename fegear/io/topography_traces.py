@@ -284,6 +284,11 @@ class TraceGrid(TopographyGrid):
         assert t is not None
         return t.where(line, (2 if line == t.at_line else 1) if line else None)
 
+    @property
+    def files(self) -> tuple[Path, ...]:
+        """The trace files the flank's deviation was read from (profile, then lead)."""
+        return tuple(t.path for t in (self.profile_trace, self.lead_trace) if t is not None)
+
     def echo(self) -> dict[str, object]:
         """What ``summary.json`` says of the traces (``inputs.topography.<flank>``)."""
         p, ld = self.profile_trace, self.lead_trace
