@@ -57,7 +57,7 @@ from fegear.ltca import LTCAOptions
 from fegear.ltca.analysis import cycle_zone
 from fegear.ltca.cycle import cycle_tca
 from fegear.ltca.zone import contact_zone
-from fegear.mesh.sector import sector_mesh
+from fegear.mesh.sector import FlankZone, sector_mesh
 from fegear.mesh.sector_geometry import sector_frame
 from fegear.pipeline.pair import build_pair
 from fegear.tca.results import ARCSEC
@@ -119,7 +119,6 @@ def patch_boxes(pos, pairs, bounds1, bounds2, side1: str, side2: str, c: int, ga
     separations that the elastic approach closes (5-15 µm on these gears): a gap of 10 µm
     holds it with the Hertz line's half-width about twice over (FZG's pitch point: ±0.39 mm
     against fegear's semi-minor axis 0.19 mm)."""
-    from fegear.mesh.sector import FlankZone
 
     def clip(t, side, u, v, b):
         u = (max(u[0], b.u_fillet), min(u[1], b.u_tip))
