@@ -121,10 +121,16 @@ def _plot(path: Path, run: GearRun, r: RunEaseOff, bounds) -> Path:
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     if np.isfinite(e.eps_um).any():
         top = float(np.nanmax(e.eps_um))
-        levels = np.linspace(0.0, top if top > 0 else 1e-3, 21)
+        # levels spaced quadratically: ε grows with the square of the distance from the valley
+        # (the bearing), so the levels are about equally spaced on the flank and the valley,
+        # where the contact is, gets as many of them as the flanks beside it
+        levels = (top if top > 0 else 1e-3) * np.linspace(0.0, 1.0, 21) ** 2
         cs = ax.contourf(e.v, e.u, e.eps_um, levels=levels, cmap="viridis")
-        ax.contour(e.v, e.u, e.eps_um, levels=levels[1::2], colors="k", linewidths=0.3)
-        fig.colorbar(cs, ax=ax, label="ease-off ε (µm, from its minimum)")
+        lines = ax.contour(e.v, e.u, e.eps_um, levels=levels[1::2], colors="k", linewidths=0.3)
+        ax.clabel(lines, levels[3:10:2], fmt="%.3g", fontsize=6)
+        bar = fig.colorbar(cs, ax=ax, label="ease-off ε (µm, from its minimum)")
+        bar.set_ticks(levels[::4])
+        bar.set_ticklabels([f"{x:.3g}" for x in levels[::4]])
         ax.plot(e.min_uv[1], e.min_uv[0], "x", color="w", ms=8, mew=1.5, label="minimum")
     if r.path_uv.size:
         o = np.argsort(r.path_uv[:, 1])
