@@ -229,12 +229,18 @@ def read_topography(key: str, name: str, folder: Path) -> TopographyGrid:
     """
     if key not in FLANKS:
         raise InputError(f"topography.{key}", name, f"a key of {FLANKS}")
+    path, text = read_text(key, name, folder, "grid")
+    return parse_topography(text, key, path)
+
+
+def read_text(key: str, name: str, folder: Path, what: str) -> tuple[Path, str]:
+    """``(path, text)`` of the ``[topography]`` file ``name`` (relative to ``folder``, the case
+    file's); an :class:`~fegear.errors.InputError` naming ``key`` where it cannot be read."""
     path = Path(name)
     if not path.is_absolute():
         path = folder / path
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        return path, path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"topography.{key}", name, "a readable grid file (UTF-8 text)",
+        raise InputError(f"topography.{key}", name, f"a readable {what} file (UTF-8 text)",
                          f"{type(exc).__name__}: {exc}") from None  # fmt: skip
-    return parse_topography(text, key, path)

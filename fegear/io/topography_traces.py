@@ -73,7 +73,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import make_interp_spline
 
 from fegear.errors import InputError
-from fegear.io.topography import FLANKS, TopographyGrid, _number
+from fegear.io.topography import FLANKS, TopographyGrid, _number, read_text
 
 __all__ = [
     "MISMATCH_WARN_UM",
@@ -237,14 +237,7 @@ def read_trace(key: str, name: str, folder: Path) -> Trace:
     InputError
         A file that cannot be read, or a bad trace (:func:`parse_trace`).
     """
-    path = Path(name)
-    if not path.is_absolute():
-        path = folder / path
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"topography.{key}", name, "a readable trace file (UTF-8 text)",
-                         f"{type(exc).__name__}: {exc}") from None  # fmt: skip
+    path, text = read_text(key, name, folder, "trace")
     return parse_trace(text, key, path)
 
 

@@ -30,7 +30,6 @@ from fegear.output.figure import pyplot as _plt
 from fegear.output.figure import save_png as _save
 from fegear.pipeline.run import GearRun
 from fegear.store.files import atomic_write, write_json
-from fegear.tca.ease_off import EaseOff
 from fegear.tca.ease_off_pair import PairEaseOff, pair_ease_off
 from fegear.tca.plots import axis_label
 from fegear.tca.results import ARCSEC
@@ -41,27 +40,17 @@ log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
-class RunEaseOff:
-    """The ease-off of a run.
+class RunEaseOff(PairEaseOff):
+    """The ease-off of a run (:class:`~fegear.tca.ease_off_pair.PairEaseOff`) and where the
+    run's positions touch it.
 
     Attributes
     ----------
-    ease_off
-        The pair as run (measured flanks where the case has them).
-    design
-        The design pair's on the same grid and assembly (a measured pair), else None.
     path_uv
         ``(n, 2)`` the TCA's contact points of the run's positions (pinion flank coordinates).
     """
 
-    ease_off: EaseOff
-    design: EaseOff | None
     path_uv: np.ndarray
-
-    @property
-    def difference_um(self) -> np.ndarray | None:
-        """``(nu, nv)`` µm, measured minus design (each ``θ_e h`` less the design's minimum)."""
-        return PairEaseOff(self.ease_off, self.design).difference_um
 
 
 def run_ease_off(run: GearRun) -> RunEaseOff:
