@@ -148,6 +148,26 @@ def markdown(doc: dict) -> str:
                 f"{q['semi_minor_mm']:.3f} | {_f(q.get('contact_area_mm2'), '.2f')} | "
                 f"{r['ccx_s']:.0f} | {_f(r['peak_MB'], '.0f')} |"
             )
+    from fegear.validation.calculix_rows import richardson
+
+    ok = [r for r in doc["rows"] if "result" in r]
+    quantities = (("lag θ", "µrad", lambda r: 1e6 * r["result"]["theta_rad"], ".1f"),
+                  ("loaded TE", "″", lambda r: r["result"]["te_loaded_arcsec"], ".2f"),
+                  ("recovered peak", "MPa", lambda r: r["result"]["pairs"][0]["p_peak_MPa"],
+                   ".0f"))  # fmt: skip
+    lines = []
+    for name, unit, get, spec in quantities:
+        ext = richardson([r["patch_mm"] for r in ok], [get(r) for r in ok])
+        if ext is not None:
+            lines.append(f"{name} {format(ext.value, spec)} {unit} (observed order "
+                         f"{ext.order:.2f}, GCI ±{100 * ext.gci:.2f} %)")  # fmt: skip
+        elif len(ok) >= 3:
+            lines.append(f"{name}: no extrapolation (the three finest sizes do not converge "
+                         "at an order in [0.5, 6])")  # fmt: skip
+    if lines:
+        head = ("Extrapolated to zero element size from the three finest patch sizes "
+                "(`fegear.validation.calculix_rows.richardson`): ")  # fmt: skip
+        L += ["", head + "; ".join(lines) + "."]
     fe = doc.get("fegear")
     if fe:
         q = fe["pairs"][0] if fe.get("pairs") else {}
@@ -156,7 +176,8 @@ def markdown(doc: dict) -> str:
             "",
             f"fegear `hybrid` level 0 at the same position (from `calculix.json`): lag "
             f"{1e6 * fe['theta']:.1f} µrad, loaded TE {fe['te_loaded']:.2f}″, interior p_max "
-            f"{_f(q.get('p_interior'), '.0f')} MPa, semi-axes {ab} mm.",
+            f"{_f(q.get('p_interior'), '.0f')} MPa (largest cell pressure "
+            f"{_f(q.get('p_max'), '.0f')} MPa), semi-axes {ab} mm.",
         ]
     return "\n".join(L) + "\n"
 
