@@ -115,10 +115,12 @@ def patch_boxes(pos, pairs, bounds1, bounds2, side1: str, side2: str, c: int, ga
     ``v`` column a parabola ``s = s₀ + κ (u − u*)²`` through the column's smallest valid
     sample and its two neighbours, the strip ``|u − u*| ≤ sqrt((gap − s₀) / κ)`` (where
     ``s₀ < gap``) widened by ``margin_mm`` on each side; on the gear the same strip's points
-    (the grid's ``gear_uv``, interpolated along ``u``). The loaded patch lies within the
-    separations that the elastic approach closes (5-15 µm on these gears): a gap of 10 µm
-    holds it with the Hertz line's half-width about twice over (FZG's pitch point: ±0.39 mm
-    against fegear's semi-minor axis 0.19 mm)."""
+    (the grid's ``gear_uv``, interpolated along ``u``). The flank parameters need not be
+    lengths (a spiral bevel's ``u`` is a fraction of the working height): the margin is turned
+    into each parameter's units with the grid's cell points (mm per unit of ``u`` and ``v``
+    there). The loaded patch lies within the separations that the elastic approach closes
+    (5-15 µm on these gears): a gap of 10 µm holds it with the Hertz line's half-width about
+    twice over (FZG's pitch point: ±0.36 mm against fegear's semi-minor axis 0.19 mm)."""
 
     def clip(t, side, u, v, b):
         u = (max(u[0], b.u_fillet), min(u[1], b.u_tip))
@@ -132,9 +134,26 @@ def patch_boxes(pos, pairs, bounds1, bounds2, side1: str, side2: str, c: int, ga
             continue
         k, j = int(g.k), int(g.j)
         u, v = np.asarray(g.u, dtype=float), np.asarray(g.v, dtype=float)
+        P, G = np.asarray(g.points, dtype=float), np.asarray(g.gear_uv, dtype=float)
         du = (u[-1] - u[0]) / max(len(u) - 1, 1)
         dv = (v[-1] - v[0]) / max(len(v) - 1, 1)
-        strips = []  # (column, u_lo, u_hi)
+
+        def scales(i0, i1, col, g=g, u=u, v=v, P=P, G=G):
+            """Margins' units at rows i0 < i1 of column col: ``(pinion u, pinion v, gear u,
+            gear v)`` per mm (the flank's length along each parameter, from the cell points)."""
+            lu = float(np.linalg.norm(P[i1, col] - P[i0, col]))
+            out = [abs(u[i1] - u[i0]) / lu, None, abs(G[i1, col, 0] - G[i0, col, 0]) / lu, None]
+            i = (i0 + i1) // 2
+            cc = [x for x in (col - 1, col, col + 1) if 0 <= x < len(v) and g.valid[i, x]]
+            if len(cc) >= 2:
+                lv = float(np.linalg.norm(P[i, cc[-1]] - P[i, cc[0]]))
+                out[1] = abs(v[cc[-1]] - v[cc[0]]) / lv
+                out[3] = abs(G[i, cc[-1], 1] - G[i, cc[0], 1]) / lv
+            else:  # a lone column: v taken as the same scale as u
+                out[1], out[3] = out[0], out[2]
+            return out
+
+        strips = []  # (column, u_lo, u_hi, margins in u, v, gear u, gear v)
         for col in range(len(v)):
             ok = np.flatnonzero(g.valid[:, col])
             if len(ok) < 3:
@@ -150,16 +169,17 @@ def patch_boxes(pos, pairs, bounds1, bounds2, side1: str, side2: str, c: int, ga
             if smin >= gap_mm or not (u[ok[0]] - du <= ustar <= u[ok[-1]] + du):
                 continue
             w = math.sqrt((gap_mm - smin) / kappa)
-            strips.append((col, ustar - w, ustar + w))
+            m = [margin_mm * f for f in scales(ok[i - 1], ok[i + 1], col)]
+            strips.append((col, ustar - w, ustar + w, *m))
 
         def gear_at(cc, us, g=g, u=u):  # the gear's (u, v) of pinion column cc at u values us
             ok = np.flatnonzero(g.valid[:, cc])
             return (np.interp(us, u[ok], g.gear_uv[ok, cc, 0]),
                     np.interp(us, u[ok], g.gear_uv[ok, cc, 1]))  # fmt: skip
 
-        for col, lo, hi in strips:
-            vc = (v[col] - 0.5 * dv - margin_mm, v[col] + 0.5 * dv + margin_mm)
-            z = clip(k + c, side1, (lo - margin_mm, hi + margin_mm), vc, bounds1)
+        for col, lo, hi, mu, mv, gmu, gmv in strips:
+            vc = (v[col] - 0.5 * dv - mv, v[col] + 0.5 * dv + mv)
+            z = clip(k + c, side1, (lo - mu, hi + mu), vc, bounds1)
             if z is not None:
                 z1.append(z)
             mid = 0.5 * (lo + hi)
@@ -169,8 +189,8 @@ def patch_boxes(pos, pairs, bounds1, bounds2, side1: str, side2: str, c: int, ga
                     if 0 <= cc < len(v) and np.sum(g.valid[:, cc]) >= 2]  # fmt: skip
             step = max((abs(float(gear_at(cc, np.array([mid]))[1][0]) - float(gv[1]))
                         for cc in near), default=abs(dv))  # fmt: skip
-            z = clip(j + c, side2, (gu.min() - margin_mm, gu.max() + margin_mm),
-                     (gv.min() - 0.5 * step - margin_mm, gv.max() + 0.5 * step + margin_mm),
+            z = clip(j + c, side2, (gu.min() - gmu, gu.max() + gmu),
+                     (gv.min() - 0.5 * step - gmv, gv.max() + 0.5 * step + gmv),
                      bounds2)  # fmt: skip
             if z is not None:
                 z2.append(z)
