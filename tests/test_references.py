@@ -100,3 +100,6 @@ def test_every_tolerance_has_its_reason():
         assert rtol <= 1e-2 and atol * scale <= 1e-2, pattern.pattern
     assert summaries.LOCATION_MM == pytest.approx(2.95e-3, rel=1e-2)
     assert summaries.LOADED_RTOL <= 1e-4
+    from fegear.tca.ease_off_pair import GRID  # the ease-off's node tolerance is one node of it
+
+    assert summaries.EASE_OFF_NODE == 1.0 / (GRID[0] * GRID[1])

@@ -29,6 +29,7 @@ import numpy as np
 from fegear.output.figure import pyplot as _plt
 from fegear.output.figure import save_png as _save
 from fegear.pipeline.run import GearRun
+from fegear.results.ease_off import FILE
 from fegear.store.files import atomic_write, write_json
 from fegear.tca.ease_off_pair import PairEaseOff, pair_ease_off
 from fegear.tca.plots import axis_label
@@ -183,5 +184,5 @@ def write_ease_off(out: Path, run: GearRun) -> list[Path]:
     return [
         _plot(out / "ease_off.png", run, r, bounds),
         atomic_write(out / "ease_off.vts", lambda q: q.write_text(text, encoding="utf-8")),
-        write_json(out / "ease_off.json", _document(r, bounds)),
+        write_json(out / FILE, _document(r, bounds)),
     ]

@@ -55,7 +55,7 @@ def _describe(e: EaseOff) -> dict[str, Any]:
 def ease_off_section(run) -> dict[str, Any] | None:
     """The ``ease_off`` section of a :class:`~fegear.pipeline.run.GearRun` (module docstring),
     or None for a run without an ease-off."""
-    pe = getattr(run, "ease_off", None)
+    pe = run.ease_off
     if pe is None:
         return None
     e = pe.ease_off

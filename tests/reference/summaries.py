@@ -106,7 +106,7 @@ ELLIPSE_ATOL = ELLIPSE_RTOL * B_MAX
 #: 500 mm (the face gear) is 5e-9 mm; its fit is linear in the gaps. 20 x that, in µm and mm
 EASE_OFF_ATOL_UM = 1e-4
 #: a node of the ease-off's grid on the border of the gear's working flank may gain or lose its
-#: contact position with round-off: one node of the 21 x 41 grid
+#: contact position with round-off: one node of the grid (21 x 41, fegear.tca.ease_off_pair.GRID)
 EASE_OFF_NODE = 1.0 / (21 * 41)
 
 #: ``(path pattern, rtol, atol, reason)``: the first pattern matching a leaf's path decides
